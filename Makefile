@@ -1,0 +1,48 @@
+# hrc — every target installs what it needs first. `make` lists them.
+SHELL := /bin/bash
+PY := .venv/bin/python
+PIP := .venv/bin/pip -q --disable-pip-version-check
+STAMP := .venv/.installed
+BENCH_STAMP := .venv/.bench-installed
+
+.DEFAULT_GOAL := help
+.PHONY: help install demo test lint bench lock clean
+
+help:  ## list the targets
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
+
+$(STAMP): requirements/lock.txt
+	@test -x $(PY) || python3 -m venv .venv
+	$(PIP) install -r requirements/lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
+	@$(PY) -c "import django, rest_framework, channels, celery, asyncua" 
+	@touch $@
+
+install: $(STAMP)  ## create .venv and install the locked dependencies (idempotent)
+
+demo: install  ## load the example library into a demo organisation and serve on 127.0.0.1:8000
+	$(PY) manage.py migrate --noinput
+	$(PY) manage.py load_demo
+	$(PY) manage.py runserver 127.0.0.1:8000
+
+test: install  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1)
+	$(PY) -m pytest -n 2 -p no:cacheprovider
+
+lint: install  ## ruff and mypy
+	.venv/bin/ruff check .
+	.venv/bin/ruff format --check .
+	.venv/bin/mypy hrc tests
+
+$(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
+	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
+	@touch $@
+
+bench: $(BENCH_STAMP)  ## time the soundness check against pm4py's Woflan; JSON in bench/results/
+	$(PY) -m bench.run
+
+lock:  ## re-resolve requirements/*.in into the lock files
+	python3 -m venv /tmp/hrc-lock && /tmp/hrc-lock/bin/pip -q install uv
+	/tmp/hrc-lock/bin/uv pip compile --python-version 3.11 requirements/dev.in -o requirements/lock.txt
+	/tmp/hrc-lock/bin/uv pip compile --python-version 3.11 requirements/bench.in -c requirements/lock.txt -o requirements/bench-lock.txt
+
+clean:  ## remove the venv, caches and the embedded database
+	rm -rf .venv var .mypy_cache .ruff_cache .pytest_cache .hypothesis

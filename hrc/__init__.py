@@ -1,0 +1,1 @@
+"""hrc: human–robot collaboration patterns, checked formally and run on the shop floor."""

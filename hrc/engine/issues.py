@@ -1,0 +1,56 @@
+"""What a check finds: issues with a stable code, a message a person can act on, and element ids."""
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+Severity = Literal["error", "warning"]
+
+# Every code the engine reports, in the order of pattern-format.md.
+CODES = (
+    "format",
+    "duplicate-id",
+    "unknown-node",
+    "arc-kind",
+    "unknown-actor",
+    "unassigned-actor",
+    "idle-actor",
+    "constraint-self",
+    "constraint-unperformed",
+    "constraint-same-performer",
+    "constraint-type",
+    "not-workflow-net",
+    "pattern-mismatch",
+    "unsound",
+    "unbounded",
+    # Warnings.
+    "vacuous-pattern",
+    "state-space-too-large",
+)
+
+
+@dataclass(frozen=True)
+class Issue:
+    code: str
+    message: str
+    elements: tuple[str, ...] = ()
+    severity: Severity = "error"
+    witness: tuple[str, ...] | None = field(default=None, compare=False)
+    """For behavioural issues: the firing sequence that shows it (names like `start tc1`)."""
+
+    def as_dict(self) -> dict[str, object]:
+        data: dict[str, object] = {
+            "code": self.code,
+            "message": self.message,
+            "elements": list(self.elements),
+        }
+        if self.witness is not None:
+            data["witness"] = list(self.witness)
+        return data
+
+
+def error(code: str, message: str, *elements: str) -> Issue:
+    return Issue(code, message, tuple(elements), "error")
+
+
+def warning(code: str, message: str, *elements: str) -> Issue:
+    return Issue(code, message, tuple(elements), "warning")
