@@ -73,7 +73,11 @@ class _Reader:
         return None
 
     def items(
-        self, data: Mapping[str, Any], key: str, where: str, read: Callable[[object, str], _T | None]
+        self,
+        data: Mapping[str, Any],
+        key: str,
+        where: str,
+        read: Callable[[object, str], _T | None],
     ) -> list[_T]:
         """Reads the list under `key` (absent means empty) with `read` for each item."""
         path = f"{where}.{key}" if where else key
@@ -101,7 +105,9 @@ class _Reader:
         if document is None:
             return None
         if document.get("format") != FORMAT:
-            self.fail(f'The document must say "format": "{FORMAT}", got {_kind(document.get("format"))}.')
+            self.fail(
+                f'The document must say "format": "{FORMAT}", got {_kind(document.get("format"))}.'
+            )
             return None
         name = self.string(document, "name", "The document", required=False) or ""
         declared = self.string(document, "declared_pattern", "The document", required=False)
@@ -132,7 +138,7 @@ class _Reader:
         actor_type = data.get("type")
         if actor_type not in ACTOR_TYPES:
             self.fail(
-                f"{where}.type must be \"cobot\" or \"operator\", got {_kind(actor_type)}.",
+                f'{where}.type must be "cobot" or "operator", got {_kind(actor_type)}.',
                 *_ids(data),
             )
             return None
@@ -175,8 +181,12 @@ class _Reader:
             return None
         place_id = self.string(data, "id", where)
         tokens = data.get("tokens")
-        if tokens is not None and (isinstance(tokens, bool) or not isinstance(tokens, int) or tokens < 0):
-            self.fail(f"{where}.tokens must be a whole number ≥ 0, got {_kind(tokens)}.", *_ids(data))
+        if tokens is not None and (
+            isinstance(tokens, bool) or not isinstance(tokens, int) or tokens < 0
+        ):
+            self.fail(
+                f"{where}.tokens must be a whole number ≥ 0, got {_kind(tokens)}.", *_ids(data)
+            )
             return None
         if place_id is None:
             return None
@@ -274,7 +284,9 @@ def _write_transition(transition: Transition) -> dict[str, Any]:
     return data
 
 
-_PATTERN_KEYS = frozenset({"format", "name", "declared_pattern", "actors", "processes", "constraints"})
+_PATTERN_KEYS = frozenset(
+    {"format", "name", "declared_pattern", "actors", "processes", "constraints"}
+)
 _ACTOR_KEYS = frozenset({"id", "type"})
 _PROCESS_KEYS = frozenset({"id", "workpiece", "actors", "places", "transitions", "arcs"})
 _PLACE_KEYS = frozenset({"id", "tokens"})

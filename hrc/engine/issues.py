@@ -24,6 +24,7 @@ CODES = (
     "unbounded",
     # Warnings.
     "vacuous-pattern",
+    "no-pattern",
     "state-space-too-large",
 )
 

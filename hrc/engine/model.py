@@ -16,7 +16,12 @@ PatternName = Literal["synchronized", "cooperation", "collaboration", "coexisten
 
 ACTOR_TYPES: tuple[ActorType, ...] = ("cobot", "operator")
 CONSTRAINT_TYPES: tuple[ConstraintType, ...] = ("time", "space", "func")
-PATTERN_NAMES: tuple[PatternName, ...] = ("synchronized", "cooperation", "collaboration", "coexistence")
+PATTERN_NAMES: tuple[PatternName, ...] = (
+    "synchronized",
+    "cooperation",
+    "collaboration",
+    "coexistence",
+)
 
 Extra = Mapping[str, Any]
 

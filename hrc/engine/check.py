@@ -1,0 +1,217 @@
+"""The whole check of a pattern document: shape, rules, classification, soundness.
+
+This is what the API, the editor's server checks, `manage.py check_pattern`
+and publishing all call, so every one of them gives the same answer.
+"""
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from hrc.engine.analysis import DEFAULT_MAX_MARKINGS, Analysis, Fault, analyse
+from hrc.engine.classify import classification_issues, classify
+from hrc.engine.document import FormatError, read_pattern
+from hrc.engine.execution import build_execution_net, constraint_places
+from hrc.engine.issues import Issue, error, warning
+from hrc.engine.model import Pattern
+from hrc.engine.petri import Marking, Net, NetTransition
+from hrc.engine.rules import STRUCTURAL_CODES, check_rules
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    valid: bool
+    """No error: a correct 7-tuple, its declared pattern holds, sound and bounded."""
+    patterns: tuple[str, ...]
+    sound: bool | None
+    """None when a rule was broken before soundness could be decided, or the space was too large."""
+    errors: tuple[Issue, ...]
+    warnings: tuple[Issue, ...]
+    stats: dict[str, int] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "valid": self.valid,
+            "patterns": list(self.patterns),
+            "sound": self.sound,
+            "errors": [issue.as_dict() for issue in self.errors],
+            "warnings": [issue.as_dict() for issue in self.warnings],
+            "stats": dict(self.stats),
+        }
+
+
+def check_document(data: object, max_markings: int = DEFAULT_MAX_MARKINGS) -> CheckReport:
+    """Checks a parsed `hrc-pattern/1` document; a shape problem gives a report, not an exception."""
+    try:
+        pattern = read_pattern(data)
+    except FormatError as exc:
+        return CheckReport(False, (), None, tuple(exc.issues), ())
+    return check_pattern(pattern, max_markings)
+
+
+def check_pattern(pattern: Pattern, max_markings: int = DEFAULT_MAX_MARKINGS) -> CheckReport:
+    issues = check_rules(pattern)
+    classification = classify(pattern)
+    issues += classification_issues(pattern, classification)
+    sound: bool | None = None
+    stats: dict[str, int] = {}
+    if not any(issue.code in STRUCTURAL_CODES for issue in issues):
+        net = build_execution_net(pattern)
+        analysis = analyse(net, max_markings)
+        issues += _analysis_issues(pattern, net, analysis)
+        sound, stats = analysis.sound, analysis.stats
+    errors = tuple(i for i in issues if i.severity == "error")
+    warnings = tuple(i for i in issues if i.severity == "warning")
+    return CheckReport(not errors, classification.patterns, sound, errors, warnings, stats)
+
+
+def _analysis_issues(pattern: Pattern, net: Net, analysis: Analysis) -> list[Issue]:
+    explain = _Explainer(pattern, net)
+    issues = [explain.fault(fault) for fault in analysis.faults if fault.kind != "dead"]
+    dead = [fault for fault in analysis.faults if fault.kind == "dead"]
+    if dead:
+        issues.append(explain.dead(dead))
+    if not analysis.decided and not analysis.faults:
+        issues.append(
+            warning(
+                "state-space-too-large",
+                f"The model is too large to decide: {analysis.markings} markings were explored "
+                "without finding a fault, and the check stops there. Split it into smaller "
+                "patterns or reduce the parallel branches.",
+            )
+        )
+    return issues
+
+
+class _Explainer:
+    """Turns faults into messages an engineer can act on, in the pattern's words."""
+
+    def __init__(self, pattern: Pattern, net: Net) -> None:
+        self.pattern = pattern
+        self.net = net
+        self.constraint_of = {place: ends for place, ends in constraint_places(pattern).items()}
+
+    def fault(self, fault: Fault) -> Issue:
+        sequence = self.sequence(fault.witness)
+        marking = fault.marking or Marking()
+        if fault.kind == "deadlock":
+            waits = self.waits(marking)
+            message = (
+                f"The model can deadlock: {sequence}, nothing more can happen and the case has "
+                f"not finished. {'; '.join(w for w, _ in waits) or 'Nothing is waiting.'}"
+            )
+            elements = [e for _, ends in waits for e in ends]
+        elif fault.kind == "improper":
+            left = sorted(
+                p for p in marking if p not in self.net.final and p not in self.net.ignored
+            )
+            message = (
+                f"The case can end with work left over: {sequence}, the end place is marked "
+                f"while {', '.join(self.place_words(p) for p in left)} still "
+                f"{'holds a token' if len(left) == 1 else 'hold tokens'}."
+            )
+            elements = [self.task_of(p) for p in left]
+        elif fault.kind == "livelock":
+            message = (
+                f"The case can loop without end: {sequence}, it can no longer reach its end "
+                "place, though tasks can still run."
+            )
+            elements = sorted({self.net.transition(f).task for f in fault.witness[-3:]})
+        else:
+            repeat = ", ".join(self.net.transition(f).label for f in fault.repeat)
+            place = fault.place or "?"
+            message = (
+                f"{self.place_words(place).capitalize()} can collect tokens without limit: "
+                f"{sequence}, repeating {repeat} adds tokens there each time."
+            )
+            issue = error("unbounded", message, self.task_of(place))
+            return Issue(
+                issue.code,
+                issue.message,
+                issue.elements,
+                witness=self.labels(fault.witness + fault.repeat),
+            )
+        return Issue(
+            "unsound", message, tuple(dict.fromkeys(elements)), witness=self.labels(fault.witness)
+        )
+
+    def dead(self, faults: list[Fault]) -> Issue:
+        """One issue for every transition that never fires: a task whose start is dead is listed once."""
+        dead = {fault.transition for fault in faults}
+        never_start, never_complete, never_fire = [], [], []
+        for transition in self.net.transitions:
+            if transition.id not in dead:
+                continue
+            if transition.kind == "start":
+                never_start.append(transition)
+            elif transition.kind == "silent":
+                never_fire.append(transition)
+            elif f"start:{transition.task}" not in dead:
+                never_complete.append(transition)
+        parts = []
+        if never_start:
+            parts.append(f"{_tasks(never_start)} can never start")
+        if never_complete:
+            parts.append(f"{_tasks(never_complete)} can start but never complete")
+        if never_fire:
+            names = ", ".join(t.task for t in never_fire)
+            parts.append(
+                f"transition {names} never fires"
+                if len(never_fire) == 1
+                else f"transitions {names} never fire"
+            )
+        message = f"{'; '.join(parts)} in any run of the model."
+        needs = [
+            f"{t.label} needs {self.constraint_words(p)}"
+            for t in never_start + never_complete
+            for p, _ in t.pre
+            if p in self.constraint_of
+        ]
+        if needs:
+            message += " " + "; ".join(needs) + "."
+        elements = [t.task for t in never_start + never_complete + never_fire]
+        return error("unsound", message[0].upper() + message[1:], *elements)
+
+    def waits(self, marking: Marking) -> list[tuple[str, list[str]]]:
+        """For each transition that has some but not all of its inputs: what it waits for."""
+        waits = []
+        for transition in self.net.transitions:
+            have = [p for p, w in transition.pre if marking.get(p) >= w]
+            missing = [p for p, w in transition.pre if marking.get(p) < w]
+            ordinary = [p for p, _ in transition.pre if p not in self.constraint_of]
+            if not missing or not have or not all(p in have for p in ordinary):
+                continue
+            needs = " and ".join(self.constraint_words(p) for p in missing)
+            ends = [transition.task, *(e for p in missing for e in self.constraint_of[p][0:1])]
+            ends = [e.split(":", 1)[-1] for e in ends]
+            waits.append((f"{transition.label} waits for {needs}", ends))
+        return waits
+
+    def constraint_words(self, place: str) -> str:
+        kind, ends = place.split(":", 1)
+        a, b = ends.split(">", 1)
+        if kind == "time":
+            return f"a completion of {a} (time constraint {a} → {b})"
+        if kind == "func-start":
+            return f"{a} to be running (func constraint: {a} supports {b})"
+        return f"{a} to complete (func constraint: {b} supports {a})"
+
+    def place_words(self, place: str) -> str:
+        if place.startswith("running:"):
+            return f"the running task {place.split(':', 1)[1]}"
+        return f"place {place}"
+
+    def task_of(self, place: str) -> str:
+        return place.split(":", 1)[1] if place.startswith("running:") else place
+
+    def labels(self, firings: tuple[str, ...]) -> tuple[str, ...]:
+        return tuple(self.net.transition(f).label for f in firings)
+
+    def sequence(self, firings: tuple[str, ...]) -> str:
+        if not firings:
+            return "right at the start"
+        return "after " + ", ".join(self.labels(firings))
+
+
+def _tasks(transitions: list[NetTransition]) -> str:
+    names = ", ".join(t.task for t in transitions)
+    return f"task {names}" if len(transitions) == 1 else f"tasks {names}"

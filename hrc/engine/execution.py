@@ -1,0 +1,134 @@
+"""The execution net: the pattern as the runtime fires it and the analysis explores it.
+
+Each task t becomes `start:t` (consumes t's input places, marks `running:t`)
+and `complete:t` (consumes `running:t`, marks t's output places); a silent
+transition stays one transition that fires at once. The constraints become
+extra places (pattern-format.md, "Execution semantics"):
+
+- time (a, b): `complete:a` puts a token in `time:a>b`, each `start:b` takes one,
+  so every start of b needs an earlier completion of a.
+- func (a, b), supporter s and supported d: `start:s` marks `func-start:s>d`,
+  which `start:d` takes (d starts only while s runs); `complete:d` marks
+  `func-done:d>s`, which `complete:s` takes (s completes only after d has).
+- space (a, b): no place; the order is free and the runtime interrupts the
+  cobot while both run.
+
+Call it only on a pattern whose rules hold (`rules.check_rules` found nothing
+structural): it assumes every arc, performer and constraint end exists.
+"""
+
+from collections import defaultdict
+from dataclasses import dataclass
+
+from hrc.engine.model import Constraint, Pattern
+from hrc.engine.petri import Marking, Net, NetTransition
+
+Arcs = dict[str, list[tuple[str, int]]]
+
+
+@dataclass(frozen=True)
+class Firing:
+    """A possible step in a marking and the marking after it."""
+
+    transition: NetTransition
+    marking: Marking
+
+
+def supporter_of(pattern: Pattern, constraint: Constraint) -> tuple[str, str]:
+    """(supporter, supported) of a func constraint: the cobot's task where exactly one is a cobot's, else t_a."""
+    kinds = []
+    for task_id in (constraint.source, constraint.target):
+        task = pattern.transition(task_id)
+        actor = pattern.actor(task.performer) if task and task.performer else None
+        kinds.append(actor.type if actor else None)
+    if kinds == ["operator", "cobot"]:
+        return constraint.target, constraint.source
+    return constraint.source, constraint.target
+
+
+def constraint_places(pattern: Pattern) -> dict[str, tuple[str, str]]:
+    """Each constraint place with (producing firing, consuming firing), e.g. `time:a>b` → (complete:a, start:b)."""
+    places: dict[str, tuple[str, str]] = {}
+    for constraint in pattern.constraints:
+        a, b = constraint.source, constraint.target
+        if constraint.type == "time":
+            places[f"time:{a}>{b}"] = (f"complete:{a}", f"start:{b}")
+        elif constraint.type == "func":
+            supporter, supported = supporter_of(pattern, constraint)
+            places[f"func-start:{supporter}>{supported}"] = (
+                f"start:{supporter}",
+                f"start:{supported}",
+            )
+            places[f"func-done:{supported}>{supporter}"] = (
+                f"complete:{supported}",
+                f"complete:{supporter}",
+            )
+    return places
+
+
+def build_execution_net(pattern: Pattern) -> Net:
+    """The execution net of a structurally valid pattern, with initial and final marking."""
+    pre: Arcs = defaultdict(list)
+    post: Arcs = defaultdict(list)
+    places: list[str] = []
+    transitions: list[tuple[str, str, str]] = []  # (id, task, kind)
+    initial: dict[str, int] = {}
+    final: dict[str, int] = {}
+    for process in pattern.processes:
+        places.extend(p.id for p in process.places)
+        initial.update(process.initial_marking())
+        for sink in process.sink_places():
+            final[sink] = final.get(sink, 0) + 1
+        inputs: Arcs = defaultdict(list)
+        outputs: Arcs = defaultdict(list)
+        for source, target in process.arcs:
+            if any(t.id == target for t in process.transitions):
+                inputs[target].append((source, 1))
+            else:
+                outputs[source].append((target, 1))
+        for transition in process.transitions:
+            t = transition.id
+            if not transition.is_task:
+                transitions.append((t, t, "silent"))
+                pre[t], post[t] = inputs[t], outputs[t]
+                continue
+            running = f"running:{t}"
+            places.append(running)
+            transitions += [(f"start:{t}", t, "start"), (f"complete:{t}", t, "complete")]
+            pre[f"start:{t}"] = list(inputs[t])
+            post[f"start:{t}"] = [(running, 1)]
+            pre[f"complete:{t}"] = [(running, 1)]
+            post[f"complete:{t}"] = list(outputs[t])
+    ignored = constraint_places(pattern)
+    for place, (producer, consumer) in ignored.items():
+        places.append(place)
+        post[producer].append((place, 1))
+        pre[consumer].append((place, 1))
+    return Net(
+        places=tuple(dict.fromkeys(places)),
+        transitions=tuple(
+            NetTransition(tid, task, kind, tuple(_merged(pre[tid])), tuple(_merged(post[tid])))  # type: ignore[arg-type]
+            for tid, task, kind in transitions
+        ),
+        initial=Marking(initial),
+        final=Marking(final),
+        ignored=frozenset(ignored),
+    )
+
+
+def possible_firings(net: Net, marking: Marking) -> list[Firing]:
+    """Every start, completion and silent firing possible in `marking`, with the marking after each.
+
+    This is the firing rule the runtime uses: a work item can be offered for
+    each `start`, a running task can be completed by each `complete`, and a
+    silent firing happens at once.
+    """
+    return [Firing(t, t.fire(marking)) for t in net.enabled(marking)]
+
+
+def _merged(arcs: list[tuple[str, int]]) -> list[tuple[str, int]]:
+    """Adds up parallel arcs to the same place (the same constraint written twice)."""
+    weights: dict[str, int] = {}
+    for place, weight in arcs:
+        weights[place] = weights.get(place, 0) + weight
+    return list(weights.items())
