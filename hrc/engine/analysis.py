@@ -208,9 +208,14 @@ def _local_faults(explorer: _Explorer) -> Iterator[Fault]:
     for state in explorer.order:
         if state not in explorer.edges:
             break  # Past the cap: not expanded, so "no successor" would be a lie.
-        if deadlock is None and not explorer.edges[state] and not explorer.is_final(state):
-            if not explorer.is_improper(state):
-                deadlock = state
+        dead = not explorer.edges[state]
+        if (
+            deadlock is None
+            and dead
+            and not explorer.is_final(state)
+            and not explorer.is_improper(state)
+        ):
+            deadlock = state
         if improper is None and explorer.is_improper(state):
             improper = state
     if deadlock is not None:
