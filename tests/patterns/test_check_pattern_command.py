@@ -136,8 +136,12 @@ def test_human_output_shows_the_firing_sequence_of_an_unsound_model(tmp_path: Pa
     assert result.returncode == 1, result.stderr
     lines = result.stdout.splitlines()
     assert lines[0] == f"{path}: INVALID"
-    unsound = next(i for i, line in enumerate(lines) if line.startswith("  error [unsound] "))
-    assert lines[unsound + 1].startswith("    firing sequence: ")
+    witnessed = [
+        following
+        for line, following in zip(lines, [*lines[1:], ""], strict=True)
+        if line.startswith("  error [unsound] ") and following.startswith("    firing sequence: ")
+    ]
+    assert witnessed, result.stdout
 
 
 def test_a_missing_file_exits_2_and_the_other_files_are_still_reported(tmp_path: Path) -> None:
