@@ -1,0 +1,98 @@
+"""An organisation (a plant, a company) and the people in it.
+
+Every object of the other apps hangs off an Organisation; what a user may see
+or change is decided by their Membership in that object's organisation.
+"""
+
+from django.conf import settings
+from django.db import models
+
+from hrc.organisations.choices import Role
+
+
+class Organisation(models.Model):
+    name = models.CharField(
+        max_length=200, help_text="The name people know the plant or company by."
+    )
+    slug = models.SlugField(
+        max_length=100,
+        unique=True,
+        help_text="Short unique identifier used in URLs and scripts (letters, digits, hyphens).",
+    )
+    created_at = models.DateTimeField(
+        auto_now_add=True, help_text="When the organisation was registered."
+    )
+
+    class Meta:
+        ordering = ["name"]
+
+    def __str__(self) -> str:
+        return self.name
+
+
+class Membership(models.Model):
+    """A user's place in one organisation; the role decides what they may change there."""
+
+    user = models.ForeignKey(
+        settings.AUTH_USER_MODEL,
+        on_delete=models.CASCADE,
+        related_name="memberships",
+        help_text="The person who belongs to the organisation.",
+    )
+    organisation = models.ForeignKey(
+        Organisation,
+        on_delete=models.CASCADE,
+        related_name="memberships",
+        help_text="The organisation the person belongs to.",
+    )
+    role = models.CharField(
+        max_length=20,
+        choices=Role.choices,
+        help_text=(
+            "Admin: manages people and cobots. Engineer: models and publishes patterns. "
+            "Operator: works on the shop floor and only reads models."
+        ),
+    )
+    joined_at = models.DateTimeField(auto_now_add=True, help_text="When the person was added.")
+
+    class Meta:
+        ordering = ["organisation__name", "user__username"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["user", "organisation"], name="membership_one_per_user_and_organisation"
+            )
+        ]
+
+    def __str__(self) -> str:
+        return f"{self.user} in {self.organisation} ({self.get_role_display()})"
+
+
+class Team(models.Model):
+    """A named group of members (a shift, a cell crew) inside one organisation."""
+
+    organisation = models.ForeignKey(
+        Organisation,
+        on_delete=models.CASCADE,
+        related_name="teams",
+        help_text="The organisation the team belongs to.",
+    )
+    name = models.CharField(
+        max_length=200, help_text="The team's name, unique in its organisation."
+    )
+    members = models.ManyToManyField(
+        Membership,
+        blank=True,
+        related_name="teams",
+        help_text="Members of the team; only members of the same organisation can join.",
+    )
+
+    class Meta:
+        ordering = ["organisation__name", "name"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["organisation", "name"], name="team_name_unique_in_organisation"
+            )
+        ]
+
+    def __str__(self) -> str:
+        return f"{self.name} ({self.organisation})"

@@ -1,0 +1,42 @@
+"""Reads about who belongs where; every permission check of the API starts here.
+
+Functions take any user, signed in or not: an anonymous user belongs nowhere.
+"""
+
+from django.contrib.auth.models import AbstractBaseUser, AnonymousUser
+from django.db.models import QuerySet
+
+from hrc.organisations.choices import WRITER_ROLES, Role
+from hrc.organisations.models import Membership, Organisation
+
+AnyUser = AbstractBaseUser | AnonymousUser
+
+
+def memberships_of(user: AnyUser) -> QuerySet[Membership]:
+    """The user's memberships with their organisations; empty for an anonymous user."""
+    if not user.is_authenticated:
+        return Membership.objects.none()
+    return Membership.objects.filter(user_id=user.pk).select_related("organisation")
+
+
+def organisations_of(user: AnyUser) -> QuerySet[Organisation]:
+    """The organisations whose data the user may read."""
+    if not user.is_authenticated:
+        return Organisation.objects.none()
+    return Organisation.objects.filter(memberships__user_id=user.pk)
+
+
+def writable_organisations(user: AnyUser) -> QuerySet[Organisation]:
+    """The organisations whose models and cobots the user may change."""
+    return organisations_of(user).filter(memberships__role__in=WRITER_ROLES)
+
+
+def role_in(user: AnyUser, organisation_id: int) -> Role | None:
+    """The user's role in the organisation; None when they are not a member."""
+    membership = memberships_of(user).filter(organisation_id=organisation_id).first()
+    return Role(membership.role) if membership else None
+
+
+def may_write_in(user: AnyUser, organisation_id: int) -> bool:
+    """Whether the user may change the organisation's models and cobots."""
+    return role_in(user, organisation_id) in WRITER_ROLES
