@@ -1,0 +1,6 @@
+from django.apps import AppConfig
+
+
+class CobotsConfig(AppConfig):
+    name = "hrc.cobots"
+    verbose_name = "Cobots"

@@ -1,0 +1,61 @@
+"""A cobot as the organisation knows it: a name, a driver and an endpoint.
+
+Credentials are referenced, not stored: `credentials_source` says where the
+worker reads them at connect time, so a database dump leaks no secrets.
+"""
+
+from django.db import models
+
+from hrc.cobots.choices import DriverKind
+from hrc.cobots.validators import validate_credentials_source, validate_endpoint
+from hrc.organisations.models import Organisation
+
+
+class Cobot(models.Model):
+    organisation = models.ForeignKey(
+        Organisation,
+        on_delete=models.CASCADE,
+        related_name="cobots",
+        help_text="The organisation that runs this cobot.",
+    )
+    name = models.CharField(
+        max_length=100,
+        help_text="The name operators see on the tablets, unique in the organisation (e.g. cobot1).",
+    )
+    driver = models.CharField(
+        max_length=20,
+        choices=DriverKind.choices,
+        default=DriverKind.SIMULATED,
+        help_text="Simulated: the built-in OPC UA simulator. UR: a Universal Robots controller.",
+    )
+    endpoint = models.CharField(
+        max_length=500,
+        validators=[validate_endpoint],
+        help_text="The cobot's OPC UA server, e.g. opc.tcp://cobot1.plant.local:4840.",
+    )
+    credentials_source = models.CharField(
+        max_length=300,
+        default="none",
+        validators=[validate_credentials_source],
+        help_text=(
+            "Where the driver reads the credentials: 'none', 'env:VARIABLE_NAME' (an environment "
+            "variable of the worker) or 'file:/run/secrets/name'. Never type the secret itself here."
+        ),
+    )
+    is_active = models.BooleanField(
+        default=True,
+        help_text="Untick to take the cobot out of service; no work is sent to an inactive cobot.",
+    )
+    created_at = models.DateTimeField(auto_now_add=True, help_text="When the cobot was registered.")
+    updated_at = models.DateTimeField(auto_now=True, help_text="When the cobot was last changed.")
+
+    class Meta:
+        ordering = ["organisation__name", "name"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["organisation", "name"], name="cobot_name_unique_in_organisation"
+            )
+        ]
+
+    def __str__(self) -> str:
+        return self.name
