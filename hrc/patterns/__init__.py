@@ -1,0 +1,1 @@
+"""Collaboration pattern models: editable drafts and their immutable published versions."""

@@ -1,0 +1,128 @@
+"""How patterns and their versions look over the API."""
+
+from typing import Any
+
+from drf_spectacular.utils import inline_serializer
+from rest_framework import serializers
+
+from hrc.organisations.api.serializers import MemberOrganisationField
+from hrc.organisations.models import Organisation
+from hrc.patterns.models import PatternModel, PatternVersion
+
+
+class PatternSummarySerializer(serializers.ModelSerializer[PatternModel]):
+    """A pattern without its draft, for lists."""
+
+    created_by: serializers.SlugRelatedField[Any] = serializers.SlugRelatedField(
+        slug_field="username", read_only=True
+    )
+    latest_version = serializers.SerializerMethodField(
+        help_text="The number of the newest published version; null if never published."
+    )
+
+    class Meta:
+        model = PatternModel
+        fields = [
+            "id",
+            "organisation",
+            "name",
+            "description",
+            "latest_version",
+            "created_by",
+            "created_at",
+            "updated_at",
+        ]
+        read_only_fields = fields
+
+    def get_latest_version(self, pattern: PatternModel) -> int | None:
+        number = getattr(pattern, "latest_version", None)
+        return int(number) if number is not None else None
+
+
+class PatternSerializer(PatternSummarySerializer):
+    """A pattern with its draft. The organisation is set at creation and fixed afterwards."""
+
+    organisation = MemberOrganisationField(
+        required=False,
+        help_text="Where the pattern goes; may be left out by a member of only one organisation.",
+    )
+    draft = serializers.JSONField(
+        required=False,
+        help_text=(
+            "An hrc-pattern/1 document; it must have the right shape but may break the "
+            "model's rules (POST /check/ reports them). Left out on creation: an empty net."
+        ),
+    )
+
+    class Meta(PatternSummarySerializer.Meta):
+        fields = [*PatternSummarySerializer.Meta.fields, "draft"]
+        read_only_fields = ["id", "latest_version", "created_by", "created_at", "updated_at"]
+
+    def validate_organisation(self, organisation: Organisation) -> Organisation:
+        if self.instance is not None and organisation.pk != self.instance.organisation_id:
+            raise serializers.ValidationError("A pattern cannot move to another organisation.")
+        return organisation
+
+
+class PatternVersionSummarySerializer(serializers.ModelSerializer[PatternVersion]):
+    published_by: serializers.SlugRelatedField[Any] = serializers.SlugRelatedField(
+        slug_field="username", read_only=True
+    )
+
+    class Meta:
+        model = PatternVersion
+        fields = ["id", "pattern", "number", "published_by", "published_at"]
+        read_only_fields = fields
+
+
+class PatternVersionSerializer(PatternVersionSummarySerializer):
+    """A published version with the document and the check report it was published with."""
+
+    document = serializers.JSONField(read_only=True)
+    report = serializers.JSONField(read_only=True)
+
+    class Meta(PatternVersionSummarySerializer.Meta):
+        fields = [*PatternVersionSummarySerializer.Meta.fields, "document", "report"]
+        read_only_fields = fields
+
+
+# The shapes below document the engine's answers in the OpenAPI schema; the views pass
+# the engine's data through as it is. (A Serializer cannot declare a field named
+# `errors`, so these are inline serializers.)
+
+
+def _check_issues() -> serializers.Serializer[Any]:
+    """A list of the engine's issues (a fresh field each time: a field has one parent)."""
+    return inline_serializer(
+        "CheckIssue",
+        {
+            "code": serializers.CharField(),
+            "message": serializers.CharField(),
+            "elements": serializers.ListField(child=serializers.CharField()),
+            "witness": serializers.ListField(child=serializers.CharField(), required=False),
+        },
+        many=True,
+    )
+
+
+def _check_report() -> serializers.Serializer[Any]:
+    return inline_serializer(
+        "CheckReport",
+        {
+            "valid": serializers.BooleanField(),
+            "patterns": serializers.ListField(child=serializers.CharField()),
+            "sound": serializers.BooleanField(allow_null=True),
+            "errors": _check_issues(),
+            "warnings": _check_issues(),
+            "stats": serializers.DictField(child=serializers.IntegerField(), required=False),
+        },
+    )
+
+
+CHECK_REPORT = _check_report()
+PUBLISH_REFUSED = inline_serializer(
+    "PublishRefused", {"detail": serializers.CharField(), "report": _check_report()}
+)
+DOCUMENT_ERROR = inline_serializer(
+    "DocumentError", {"detail": serializers.CharField(), "errors": _check_issues()}
+)

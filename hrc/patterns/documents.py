@@ -1,0 +1,103 @@
+"""The patterns app's one door to the engine: reading, checking and converting documents.
+
+Every other module of the app goes through these functions, so a change in
+the engine's interface is absorbed here.
+"""
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+from django.core.exceptions import ValidationError
+
+from hrc.engine import FORMAT, FormatError, check_document, read_pattern, write_pattern
+from hrc.engine.model import Pattern
+from hrc.engine.pnml import pattern_to_pnml, pnml_to_pattern
+
+# Deeper than any real pattern document (about 6 levels, plus the editor's layout),
+# shallow enough that nothing downstream (json, jsonb, the serializers) recurses too far.
+MAX_DEPTH = 64
+
+Report = dict[str, Any]
+
+
+def read_draft(document: object) -> Pattern:
+    """Reads a draft; raises FormatError when it is not the shape of `hrc-pattern/1`.
+
+    Only the shape counts: a draft may break the model's rules (duplicate ids,
+    an unsound net); `check_report` says what is wrong with it.
+    """
+    return read_pattern(document)
+
+
+def check_report(document: object) -> Report:
+    """The engine's full check of a document as JSON-ready data; never raises for bad input."""
+    return check_document(document).as_dict()
+
+
+def is_publishable(report: Report) -> bool:
+    """Valid, and soundness was not found lacking (None means it was not decided)."""
+    return bool(report.get("valid")) and report.get("sound") is not False
+
+
+def starter_document(name: str) -> dict[str, Any]:
+    """The smallest readable draft: one empty net, for a pattern created without one."""
+    return {
+        "format": FORMAT,
+        "name": name,
+        "actors": [],
+        "processes": [
+            {"id": "N", "actors": [], "places": [{"id": "p1"}], "transitions": [], "arcs": []}
+        ],
+        "constraints": [],
+    }
+
+
+def from_pnml(text: bytes) -> dict[str, Any]:
+    """An `hrc-pattern/1` document from PNML; raises FormatError on bad or hostile XML."""
+    return write_pattern(pnml_to_pattern(text))
+
+
+def to_pnml(document: object) -> str:
+    """The PNML text of a stored document; raises FormatError when it is unreadable."""
+    return pattern_to_pnml(read_pattern(document))
+
+
+def storage_problem(value: object) -> str | None:
+    """Why PostgreSQL's jsonb (or a later reader) would refuse this value; None when it is fine.
+
+    jsonb refuses the NUL character and non-finite numbers, and very deep
+    nesting makes readers recurse without bound.
+    """
+    for item, depth in _walk(value):
+        if depth > MAX_DEPTH:
+            return f"The JSON is nested more than {MAX_DEPTH} levels deep."
+        if isinstance(item, str) and "\x00" in item:
+            return "The JSON contains a NUL character (\\u0000), which cannot be stored."
+        if isinstance(item, float) and not math.isfinite(item):
+            return "The JSON contains a number that is not finite."
+    return None
+
+
+def validate_storable_document(value: object) -> None:
+    """Model-field validator: a readable `hrc-pattern/1` document that the database can store."""
+    problem = storage_problem(value)
+    if problem:
+        raise ValidationError(problem)
+    try:
+        read_draft(value)
+    except FormatError as exc:
+        raise ValidationError([issue.message for issue in exc.issues]) from None
+
+
+def _walk(value: object) -> Iterator[tuple[object, int]]:
+    """Every value and key inside `value` with its depth, without recursion."""
+    stack: list[tuple[object, int]] = [(value, 1)]
+    while stack:
+        item, depth = stack.pop()
+        yield item, depth
+        if isinstance(item, dict):
+            stack.extend((key, depth) for key in item)
+            stack.extend((child, depth + 1) for child in item.values())
+        elif isinstance(item, list):
+            stack.extend((child, depth + 1) for child in item)

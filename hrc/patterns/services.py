@@ -1,0 +1,145 @@
+"""Every write to patterns and their versions.
+
+The caller has checked that the acting user may write in the pattern's
+organisation (hrc.organisations.selectors.may_write_in); these functions
+check the data. Errors:
+
+- FormatError (from the engine): the draft is not `hrc-pattern/1` in shape;
+- django.core.exceptions.ValidationError: another field breaks the model's rules;
+- PublishRefused: the draft does not pass the check, with the report;
+- PatternHasVersions: a published pattern cannot be deleted.
+"""
+
+from typing import Any
+
+from django.contrib.auth.models import User
+from django.core.exceptions import ValidationError
+from django.db import transaction
+from django.db.models import Max
+
+from hrc.organisations.models import Organisation
+from hrc.patterns.documents import (
+    Report,
+    check_report,
+    is_publishable,
+    read_draft,
+    starter_document,
+    storage_problem,
+)
+from hrc.patterns.models import PatternModel, PatternVersion
+
+NAME_LENGTH = PatternModel._meta.get_field("name").max_length or 200
+
+
+class PublishRefused(Exception):
+    """The draft is not valid or not sound; `report` is the check that says why."""
+
+    def __init__(self, report: Report) -> None:
+        super().__init__("The draft does not pass the check.")
+        self.report = report
+
+
+class PatternHasVersions(Exception):
+    """The pattern has published versions, which are kept as the record cases run against."""
+
+
+def create_pattern(
+    organisation: Organisation,
+    *,
+    name: str,
+    created_by: User | None,
+    description: str = "",
+    draft: object = None,
+) -> PatternModel:
+    """Creates a pattern with `draft`, or with a starter document when draft is None.
+
+    The draft must have the shape of `hrc-pattern/1`; it may break the rules.
+    """
+    document = starter_document(name) if draft is None else draft
+    _check_draft(document)
+    pattern = PatternModel(
+        organisation=organisation,
+        name=name,
+        description=description,
+        draft=document,
+        created_by=created_by,
+    )
+    pattern.full_clean(exclude=["draft"])
+    pattern.save()
+    return pattern
+
+
+def update_pattern(
+    pattern: PatternModel,
+    *,
+    name: str | None = None,
+    description: str | None = None,
+    draft: object = None,
+) -> PatternModel:
+    """Saves the given fields of an existing pattern (None leaves a field as it is).
+
+    Published versions are not touched: they keep the document they were published with.
+    """
+    changes: dict[str, Any] = {"name": name, "description": description, "draft": draft}
+    changes = {field: value for field, value in changes.items() if value is not None}
+    if "draft" in changes:
+        _check_draft(changes["draft"])
+    for field, value in changes.items():
+        setattr(pattern, field, value)
+    pattern.full_clean(exclude=["draft"])
+    pattern.save(update_fields=[*changes, "updated_at"])
+    return pattern
+
+
+def delete_pattern(pattern: PatternModel) -> None:
+    """Deletes a pattern that was never published; raises PatternHasVersions otherwise."""
+    if pattern.versions.exists():
+        raise PatternHasVersions(
+            f"{pattern} has published versions; they stay as the record cases run against."
+        )
+    pattern.delete()
+
+
+def import_pattern(
+    organisation: Organisation,
+    *,
+    document: object,
+    created_by: User | None,
+    name: str | None = None,
+) -> PatternModel:
+    """Creates a pattern from an imported document, named after the document unless `name` is given."""
+    titled = document.get("name") if isinstance(document, dict) else None
+    chosen = name or (titled if isinstance(titled, str) and titled.strip() else "Imported pattern")
+    return create_pattern(
+        organisation, name=chosen.strip()[:NAME_LENGTH], created_by=created_by, draft=document
+    )
+
+
+def publish_pattern(pattern: PatternModel, *, published_by: User) -> PatternVersion:
+    """Publishes the pattern's current draft as its next version; raises PublishRefused.
+
+    The pattern row is locked for the whole check, so the draft that is checked
+    is the draft that is published, and concurrent publishes number 1, 2, 3…
+    without gaps or collisions.
+    """
+    with transaction.atomic():
+        locked = PatternModel.objects.select_for_update().get(pk=pattern.pk)
+        report = check_report(locked.draft)
+        if not is_publishable(report):
+            raise PublishRefused(report)
+        last = locked.versions.aggregate(last=Max("number"))["last"] or 0
+        return PatternVersion.objects.create(
+            pattern=locked,
+            number=last + 1,
+            document=locked.draft,
+            report=report,
+            published_by=published_by,
+        )
+
+
+def _check_draft(document: object) -> None:
+    """Raises ValidationError when the database cannot store it, FormatError when it is no pattern."""
+    problem = storage_problem(document)
+    if problem:
+        raise ValidationError({"draft": problem})
+    read_draft(document)

@@ -1,0 +1,1 @@
+"""Background jobs of the patterns app: none; checks are fast enough to run in the request."""
