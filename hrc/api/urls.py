@@ -3,5 +3,7 @@
 from django.urls import include, path
 
 urlpatterns = [
+    path("", include("hrc.organisations.api.urls")),
     path("", include("hrc.patterns.api.urls")),
+    path("", include("hrc.cobots.api.urls")),
 ]

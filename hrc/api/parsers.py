@@ -1,0 +1,75 @@
+"""Request parsers that keep the body limits Django applies to forms.
+
+DRF's JSONParser reads the whole stream with no size limit, so
+DATA_UPLOAD_MAX_MEMORY_SIZE would not protect the API; and json.load lets
+through values PostgreSQL refuses (NUL, Infinity) and nesting deep enough to
+overflow the stack. These parsers refuse all of that as 400 or 413.
+"""
+
+import json
+from collections.abc import Mapping
+from typing import IO, Any
+
+from django.conf import settings
+from django.core.exceptions import RequestDataTooBig
+from django.http import HttpRequest
+from rest_framework.exceptions import ParseError
+from rest_framework.parsers import JSONParser
+
+from hrc.patterns.documents import storage_problem
+
+
+def body_limit() -> int:
+    return int(settings.DATA_UPLOAD_MAX_MEMORY_SIZE or 0) or 2 * 1024 * 1024
+
+
+def read_limited(stream: IO[bytes], parser_context: Mapping[str, Any] | None) -> bytes:
+    """The whole body; raises RequestDataTooBig (→ 413) past the limit, declared or actual."""
+    limit = body_limit()
+    request = (parser_context or {}).get("request")
+    meta = getattr(request, "META", {})
+    declared = meta.get("CONTENT_LENGTH") or meta.get("HTTP_CONTENT_LENGTH") or "0"
+    if declared.isdigit() and int(declared) > limit:
+        raise RequestDataTooBig("The request body is larger than the limit.")
+    body = stream.read(limit + 1)
+    if len(body) > limit:
+        raise RequestDataTooBig("The request body is larger than the limit.")
+    return body
+
+
+def parse_json_body(body: bytes) -> Any:
+    """Parsed JSON; raises ParseError (400) for bad syntax and values the database refuses."""
+    try:
+        data = json.loads(body, parse_constant=_refuse_constant)
+    except RecursionError:
+        raise ParseError("JSON parse error - the JSON is nested too deeply.") from None
+    except ValueError as exc:  # JSONDecodeError, UnicodeDecodeError, huge integers
+        raise ParseError(f"JSON parse error - {exc}") from None
+    problem = storage_problem(data)
+    if problem:
+        raise ParseError(f"JSON parse error - {problem}")
+    return data
+
+
+def read_body(request: HttpRequest) -> bytes:
+    """The raw body of a request whose view reads it itself; RequestDataTooBig past the limit."""
+    body = request.body  # Django refuses a declared length over the limit here
+    if len(body) > body_limit():
+        raise RequestDataTooBig("The request body is larger than the limit.")
+    return body
+
+
+class LimitedJSONParser(JSONParser):
+    """JSON within the body limit, with only values the database can store."""
+
+    def parse(
+        self,
+        stream: IO[Any],
+        media_type: str | None = None,
+        parser_context: Mapping[str, Any] | None = None,
+    ) -> Any:
+        return parse_json_body(read_limited(stream, parser_context))
+
+
+def _refuse_constant(name: str) -> None:
+    raise ValueError(f"{name} is not a JSON number")
