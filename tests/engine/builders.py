@@ -1,0 +1,80 @@
+"""Small `hrc-pattern/1` documents for engine tests, built from a compact description.
+
+`net("p1 t1 p2", "p2 t2 p3")` reads each string as a path of alternating
+nodes; ids starting with `p` are places, anything else a transition. Tasks
+get performers from `performers`; everything else is silent.
+"""
+
+import json
+from pathlib import Path
+from typing import Any
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples"
+
+
+def example(name: str) -> dict[str, Any]:
+    """One document of the shipped example library, by file stem."""
+    data: dict[str, Any] = json.loads((EXAMPLES / f"{name}.json").read_text())
+    return data
+
+
+def process(
+    process_id: str,
+    *paths: str,
+    performers: dict[str, str],
+    workpiece: str = "w",
+) -> dict[str, Any]:
+    places: list[str] = []
+    transitions: list[str] = []
+    arcs: list[list[str]] = []
+    for path in paths:
+        nodes = path.split()
+        for node in nodes:
+            bucket = places if node.startswith("p") else transitions
+            if node not in bucket:
+                bucket.append(node)
+        arcs += [[a, b] for a, b in zip(nodes, nodes[1:], strict=False) if [a, b] not in arcs]
+    return {
+        "id": process_id,
+        "workpiece": workpiece,
+        "actors": sorted({performers[t] for t in transitions if t in performers}),
+        "places": [{"id": p} for p in places],
+        "transitions": [
+            {"id": t, **({"performer": performers[t]} if t in performers else {})}
+            for t in transitions
+        ],
+        "arcs": arcs,
+    }
+
+
+def document(
+    *processes: dict[str, Any],
+    constraints: list[tuple[str, str, str]] = (),  # type: ignore[assignment]
+    actors: dict[str, str] | None = None,
+    declared: str | None = None,
+) -> dict[str, Any]:
+    """A document; actors default to every performer, `c…` a cobot and anything else an operator."""
+    if actors is None:
+        names = sorted({a for p in processes for a in p["actors"]})
+        actors = {a: "cobot" if a.startswith("c") else "operator" for a in names}
+    data: dict[str, Any] = {
+        "format": "hrc-pattern/1",
+        "name": "test",
+        "actors": [{"id": a, "type": t} for a, t in actors.items()],
+        "processes": list(processes),
+        "constraints": [{"from": a, "to": b, "type": t} for a, b, t in constraints],
+    }
+    if declared:
+        data["declared_pattern"] = declared
+    return data
+
+
+def two_lanes(constraints: list[tuple[str, str, str]], declared: str | None = None) -> dict[str, Any]:
+    """An AND-split into a cobot lane (tc1→tc2→tc3) and an operator lane (to1→to2), joined again."""
+    lanes = process(
+        "N",
+        "p1 t1 p2 tc1 p3 tc2 p4 tc3 p5 t2 p9",
+        "t1 p6 to1 p7 to2 p8 t2",
+        performers={"tc1": "c", "tc2": "c", "tc3": "c", "to1": "o", "to2": "o"},
+    )
+    return document(lanes, constraints=constraints, declared=declared)

@@ -1,0 +1,64 @@
+"""A plain exhaustive reachability search: the yardstick the engine's reduced search must agree with.
+
+Deliberately naive and independent of `hrc.engine.analysis`: no reduction,
+the whole execution net, the textbook definition of soundness (van der
+Aalst) with constraint places set aside for proper completion, and the
+Karp–Miller ancestor cover test for unboundedness.
+"""
+
+from collections import deque
+
+from hrc.engine.petri import Marking, Net
+
+
+def plain_soundness(net: Net, limit: int = 100_000) -> bool:
+    """True when sound and bounded; raises RuntimeError past `limit` markings."""
+    start = net.initial
+    parents: dict[Marking, Marking | None] = {start: None}
+    successors: dict[Marking, list[Marking]] = {}
+    fired: set[str] = set()
+    queue = deque([start])
+    while queue:
+        marking = queue.popleft()
+        successors[marking] = []
+        for transition in net.transitions:
+            if not transition.is_enabled(marking):
+                continue
+            after = transition.fire(marking)
+            fired.add(transition.id)
+            successors[marking].append(after)
+            if after in parents:
+                continue
+            parents[after] = marking
+            if _covers_an_ancestor(after, parents):
+                return False
+            if len(parents) > limit:
+                raise RuntimeError("state space over the limit")
+            queue.append(after)
+    if any(_ends_improperly(net, m) for m in parents):
+        return False
+    if fired != {t.id for t in net.transitions}:
+        return False
+    can_finish = {m for m in parents if net.is_final(m)}
+    changed = True
+    while changed:
+        changed = False
+        for marking, nexts in successors.items():
+            if marking not in can_finish and any(n in can_finish for n in nexts):
+                can_finish.add(marking)
+                changed = True
+    return len(can_finish) == len(parents)
+
+
+def _covers_an_ancestor(marking: Marking, parents: dict[Marking, Marking | None]) -> bool:
+    ancestor = parents[marking]
+    while ancestor is not None:
+        if ancestor != marking and all(marking.get(p) >= n for p, n in ancestor.items()):
+            return True
+        ancestor = parents[ancestor]
+    return False
+
+
+def _ends_improperly(net: Net, marking: Marking) -> bool:
+    covers = all(marking.get(p) >= n for p, n in net.final.items())
+    return covers and not net.is_final(marking)

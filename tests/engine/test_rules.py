@@ -1,0 +1,180 @@
+"""Every rule of pattern-format.md, each with a model that breaks it and nothing else."""
+
+import copy
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+
+from hrc.engine import check_document
+from hrc.engine.issues import CODES
+from tests.engine.builders import document, process, two_lanes
+
+Doc = dict[str, Any]
+
+
+def _mutated(change: Callable[[Doc], None]) -> Doc:
+    data = two_lanes([("to1", "tc2", "time")])
+    change(data)
+    return data
+
+
+def _net(data: Doc) -> Doc:
+    net: Doc = data["processes"][0]
+    return net
+
+
+def _duplicate_id(data: Doc) -> None:
+    _net(data)["places"].append({"id": "tc1"})
+    _net(data)["arcs"].append(["tc3", "tc1"])
+
+
+def _rename_sink_to_collide(data: Doc) -> None:
+    data["actors"].append({"id": "N", "type": "cobot"})
+
+
+def _arc_to_nowhere(data: Doc) -> None:
+    _net(data)["arcs"].append(["tc1", "p42"])
+
+
+def _arc_between_places(data: Doc) -> None:
+    _net(data)["arcs"].append(["p2", "p3"])
+
+
+def _unknown_performer(data: Doc) -> None:
+    _net(data)["transitions"][2]["performer"] = "c9"
+
+
+def _unassigned_actor(data: Doc) -> None:
+    data["actors"].append({"id": "c2", "type": "cobot"})
+
+
+def _idle_actor(data: Doc) -> None:
+    data["actors"].append({"id": "o2", "type": "operator"})
+    _net(data)["actors"].append("o2")
+
+
+def _self_constraint(data: Doc) -> None:
+    data["constraints"].append({"from": "tc1", "to": "tc1", "type": "time"})
+
+
+def _unperformed_constraint(data: Doc) -> None:
+    data["constraints"].append({"from": "t1", "to": "to2", "type": "time"})
+
+
+def _same_performer_constraint(data: Doc) -> None:
+    data["constraints"].append({"from": "tc1", "to": "tc3", "type": "time"})
+
+
+def _constraint_type(data: Doc) -> None:
+    data["constraints"].append({"from": "tc1", "to": "to2", "type": "temporal"})
+
+
+def _two_sinks(data: Doc) -> None:
+    _net(data)["places"].append({"id": "p10"})
+    _net(data)["arcs"].append(["tc1", "p10"])
+
+
+def _stray_cycle(data: Doc) -> None:
+    _net(data)["places"].append({"id": "p10"})
+    _net(data)["transitions"].append({"id": "t3"})
+    _net(data)["arcs"] += [["p10", "t3"], ["t3", "p10"]]
+
+
+def _declared_wrongly(data: Doc) -> None:
+    data["declared_pattern"] = "cooperation"
+
+
+def _deadlock(data: Doc) -> None:
+    data["constraints"].append({"from": "tc3", "to": "to1", "type": "time"})
+
+
+def _unbounded(data: Doc) -> None:
+    # A loop around the cobot's first task: every round adds a token for tc2.
+    _net(data)["transitions"].append({"id": "t3"})
+    _net(data)["arcs"] += [["p3", "t3"], ["t3", "p2"], ["t3", "p3"]]
+
+
+CASES: list[tuple[str, Callable[[Doc], None], str, set[str]]] = [
+    ("duplicate id across places and transitions", _duplicate_id, "duplicate-id", {"tc1"}),
+    ("duplicate id across actors and processes", _rename_sink_to_collide, "duplicate-id", {"N"}),
+    ("arc names a node that does not exist", _arc_to_nowhere, "unknown-node", {"p42"}),
+    ("arc joins two places", _arc_between_places, "arc-kind", {"p2", "p3"}),
+    ("performer is not an actor", _unknown_performer, "unknown-actor", {"c9"}),
+    ("actor in no process", _unassigned_actor, "unassigned-actor", {"c2"}),
+    ("assigned actor performs nothing", _idle_actor, "idle-actor", {"o2"}),
+    ("constraint joins a task to itself", _self_constraint, "constraint-self", {"tc1"}),
+    ("constraint on a silent transition", _unperformed_constraint, "constraint-unperformed", {"t1"}),
+    ("constraint between one actor's tasks", _same_performer_constraint, "constraint-same-performer", {"tc1", "tc3"}),
+    ("constraint of an unknown type", _constraint_type, "constraint-type", {"tc1", "to2"}),
+    ("process with two sink places", _two_sinks, "not-workflow-net", {"p9", "p10"}),
+    ("node on no path from source to sink", _stray_cycle, "not-workflow-net", {"p10", "t3"}),
+    ("declared pattern does not hold", _declared_wrongly, "pattern-mismatch", set()),
+    ("time constraints against each other", _deadlock, "unsound", {"tc2", "to1"}),
+    ("a loop that adds a token each round", _unbounded, "unbounded", set()),
+]
+
+
+@pytest.mark.parametrize(("change", "code", "elements"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_each_broken_rule_is_reported_with_its_code_and_elements(
+    change: Callable[[Doc], None], code: str, elements: set[str]
+) -> None:
+    report = check_document(_mutated(change))
+
+    codes = [issue.code for issue in report.errors]
+    assert code in codes, report.as_dict()
+    issue = next(i for i in report.errors if i.code == code)
+    assert elements <= set(issue.elements)
+    assert len(issue.message) > 20
+    assert report.valid is False
+
+
+def test_the_unmutated_model_breaks_no_rule() -> None:
+    report = check_document(_mutated(lambda data: None))
+
+    assert report.errors == ()
+    assert report.valid is True
+    assert report.sound is True
+
+
+def test_every_error_code_has_a_case_here_or_in_the_format_tests() -> None:
+    covered = {case[2] for case in CASES} | {"format"}  # format: tests/engine/test_document.py
+    warnings = {"vacuous-pattern", "no-pattern", "state-space-too-large"}
+
+    assert set(CODES) - warnings == covered
+
+
+def test_a_broken_rule_leaves_soundness_undecided() -> None:
+    report = check_document(_mutated(_arc_between_places))
+
+    assert report.sound is None
+
+
+def test_all_broken_rules_are_reported_at_once() -> None:
+    data = _mutated(_arc_between_places)
+    _self_constraint(data)
+    _unassigned_actor(data)
+
+    codes = {issue.code for issue in check_document(data).errors}
+
+    assert {"arc-kind", "constraint-self", "unassigned-actor"} <= codes
+
+
+def test_an_arc_into_another_process_names_that_process() -> None:
+    first = process("N1", "p11 tc1 p12", performers={"tc1": "c"}, workpiece="w1")
+    second = process("N2", "p21 to1 p22", performers={"to1": "o"}, workpiece="w2")
+    second["arcs"].append(["to1", "p12"])
+
+    report = check_document(document(first, second))
+
+    issue = next(i for i in report.errors if i.code == "unknown-node")
+    assert "belongs to process N1" in issue.message
+
+
+def test_mutations_do_not_leak_between_cases() -> None:
+    base = two_lanes([("to1", "tc2", "time")])
+    copied = copy.deepcopy(base)
+
+    _duplicate_id(copied)
+
+    assert base != copied
