@@ -69,6 +69,10 @@ def exception_handler(exc: Exception, context: dict[str, Any]) -> Response | Non
     return response
 
 
+# Where DRF and Django put errors that belong to no single field.
+NON_FIELD_KEYS = frozenset({"non_field_errors", "__all__"})
+
+
 def _with_summary(data: Any) -> dict[str, Any]:
     """`{"detail": first message, "fields": DRF's field errors}`; lists become the detail."""
     if isinstance(data, dict):
@@ -92,4 +96,4 @@ def _first_message(data: Any, path: str = "") -> str:
             if found:
                 return found
         return ""
-    return f"{path}: {data}" if path and path != "non_field_errors" else str(data)
+    return f"{path}: {data}" if path and path not in NON_FIELD_KEYS else str(data)

@@ -1,9 +1,11 @@
-"""Request parsers that keep the body limits Django applies to forms.
+"""Request parsers that refuse, as 400 or 413, what would otherwise become a 500.
 
-DRF's JSONParser reads the whole stream with no size limit, so
-DATA_UPLOAD_MAX_MEMORY_SIZE would not protect the API; and json.load lets
-through values PostgreSQL refuses (NUL, Infinity) and nesting deep enough to
-overflow the stack. These parsers refuse all of that as 400 or 413.
+- nesting deep enough to overflow the stack (json raises RecursionError, which
+  DRF's JSONParser does not catch);
+- values PostgreSQL's jsonb refuses (NUL, Infinity, NaN);
+- a body over DATA_UPLOAD_MAX_MEMORY_SIZE. DRF 3.18 already reads JSON bodies
+  through Django's `request.body`, which checks the limit; `read_limited`
+  checks again so the limit holds whatever stream DRF hands over.
 """
 
 import json

@@ -53,7 +53,9 @@ class Cobot(models.Model):
         ordering = ["organisation__name", "name"]
         constraints = [
             models.UniqueConstraint(
-                fields=["organisation", "name"], name="cobot_name_unique_in_organisation"
+                fields=["organisation", "name"],
+                name="cobot_name_unique_in_organisation",
+                violation_error_message="The organisation already has a cobot of this name.",
             )
         ]
 

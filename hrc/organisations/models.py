@@ -59,7 +59,9 @@ class Membership(models.Model):
         ordering = ["organisation__name", "user__username"]
         constraints = [
             models.UniqueConstraint(
-                fields=["user", "organisation"], name="membership_one_per_user_and_organisation"
+                fields=["user", "organisation"],
+                name="membership_one_per_user_and_organisation",
+                violation_error_message="This person is already a member of the organisation.",
             )
         ]
 
@@ -90,7 +92,9 @@ class Team(models.Model):
         ordering = ["organisation__name", "name"]
         constraints = [
             models.UniqueConstraint(
-                fields=["organisation", "name"], name="team_name_unique_in_organisation"
+                fields=["organisation", "name"],
+                name="team_name_unique_in_organisation",
+                violation_error_message="The organisation already has a team of this name.",
             )
         ]
 

@@ -28,7 +28,12 @@ def organisations_of(user: AnyUser) -> QuerySet[Organisation]:
 
 def writable_organisations(user: AnyUser) -> QuerySet[Organisation]:
     """The organisations whose models and cobots the user may change."""
-    return organisations_of(user).filter(memberships__role__in=WRITER_ROLES)
+    if not user.is_authenticated:
+        return Organisation.objects.none()
+    # One filter() call: both conditions must hold for the same membership row.
+    return Organisation.objects.filter(
+        memberships__user_id=user.pk, memberships__role__in=WRITER_ROLES
+    )
 
 
 def role_in(user: AnyUser, organisation_id: int) -> Role | None:

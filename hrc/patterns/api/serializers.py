@@ -2,7 +2,6 @@
 
 from typing import Any
 
-from drf_spectacular.utils import inline_serializer
 from rest_framework import serializers
 
 from hrc.organisations.api.serializers import MemberOrganisationField
@@ -86,43 +85,58 @@ class PatternVersionSerializer(PatternVersionSummarySerializer):
         read_only_fields = fields
 
 
-# The shapes below document the engine's answers in the OpenAPI schema; the views pass
-# the engine's data through as it is. (A Serializer cannot declare a field named
-# `errors`, so these are inline serializers.)
+# The serializers below document the engine's answers in the OpenAPI schema; the views
+# pass the engine's data through as it is.
 
 
-def _check_issues() -> serializers.Serializer[Any]:
-    """A list of the engine's issues (a fresh field each time: a field has one parent)."""
-    return inline_serializer(
-        "CheckIssue",
-        {
-            "code": serializers.CharField(),
-            "message": serializers.CharField(),
-            "elements": serializers.ListField(child=serializers.CharField()),
-            "witness": serializers.ListField(child=serializers.CharField(), required=False),
-        },
-        many=True,
+class CheckIssueSerializer(serializers.Serializer[dict[str, Any]]):
+    code = serializers.CharField(
+        help_text="A stable code from pattern-format.md, e.g. duplicate-id."
+    )
+    message = serializers.CharField()
+    elements = serializers.ListField(child=serializers.CharField())
+    witness = serializers.ListField(
+        child=serializers.CharField(),
+        required=False,
+        help_text="For behavioural issues: a firing sequence that shows the problem.",
     )
 
 
-def _check_report() -> serializers.Serializer[Any]:
-    return inline_serializer(
-        "CheckReport",
-        {
-            "valid": serializers.BooleanField(),
-            "patterns": serializers.ListField(child=serializers.CharField()),
-            "sound": serializers.BooleanField(allow_null=True),
-            "errors": _check_issues(),
-            "warnings": _check_issues(),
-            "stats": serializers.DictField(child=serializers.IntegerField(), required=False),
-        },
+class _WithIssueLists(serializers.Serializer[dict[str, Any]]):
+    """Adds issue lists named in `issue_lists`.
+
+    They are added in get_fields because a class attribute named `errors` would
+    collide with Serializer.errors.
+    """
+
+    issue_lists: tuple[str, ...] = ()
+
+    def get_fields(self) -> dict[str, serializers.Field[Any, Any, Any, Any]]:
+        fields = super().get_fields()
+        for name in self.issue_lists:
+            fields[name] = CheckIssueSerializer(many=True)
+        return fields
+
+
+class CheckReportSerializer(_WithIssueLists):
+    issue_lists = ("errors", "warnings")
+
+    valid = serializers.BooleanField(help_text="No error: publishable when sound is not false.")
+    patterns = serializers.ListField(
+        child=serializers.CharField(), help_text="Every pattern whose requirements hold."
     )
+    sound = serializers.BooleanField(
+        allow_null=True, help_text="null when a rule was broken before soundness could be decided."
+    )
+    stats = serializers.DictField(child=serializers.IntegerField(), required=False)
 
 
-CHECK_REPORT = _check_report()
-PUBLISH_REFUSED = inline_serializer(
-    "PublishRefused", {"detail": serializers.CharField(), "report": _check_report()}
-)
-DOCUMENT_ERROR = inline_serializer(
-    "DocumentError", {"detail": serializers.CharField(), "errors": _check_issues()}
-)
+class PublishRefusedSerializer(serializers.Serializer[dict[str, Any]]):
+    detail = serializers.CharField()
+    report = CheckReportSerializer()
+
+
+class DocumentErrorSerializer(_WithIssueLists):
+    issue_lists = ("errors",)
+
+    detail = serializers.CharField()

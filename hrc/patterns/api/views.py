@@ -24,13 +24,13 @@ from hrc.api.parsers import LimitedJSONParser, parse_json_body, read_body
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
 from hrc.patterns import services
 from hrc.patterns.api.serializers import (
-    CHECK_REPORT,
-    DOCUMENT_ERROR,
-    PUBLISH_REFUSED,
+    CheckReportSerializer,
+    DocumentErrorSerializer,
     PatternSerializer,
     PatternSummarySerializer,
     PatternVersionSerializer,
     PatternVersionSummarySerializer,
+    PublishRefusedSerializer,
 )
 from hrc.patterns.choices import DocumentFormat
 from hrc.patterns.documents import check_report, from_pnml, to_pnml
@@ -54,7 +54,7 @@ EXPORT_RESPONSES = {
 
 
 @extend_schema(
-    responses={201: PatternSerializer, 400: DOCUMENT_ERROR},
+    responses={201: PatternSerializer, 400: DocumentErrorSerializer},
     methods=["POST", "PUT", "PATCH"],
 )
 class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
@@ -99,13 +99,15 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         except services.PatternHasVersions as exc:
             raise Rejected({"detail": str(exc)}, status.HTTP_409_CONFLICT) from None
 
-    @extend_schema(request=None, responses={200: CHECK_REPORT})
+    @extend_schema(request=None, responses={200: CheckReportSerializer})
     @action(detail=True, methods=["post"])
     def check(self, request: Request, pk: str | None = None) -> Response:
         """Checks the draft with the engine: rules, pattern classification, soundness."""
         return Response(check_report(self.get_object().draft))
 
-    @extend_schema(request=None, responses={201: PatternVersionSerializer, 400: PUBLISH_REFUSED})
+    @extend_schema(
+        request=None, responses={201: PatternVersionSerializer, 400: PublishRefusedSerializer}
+    )
     @action(detail=True, methods=["post"])
     def publish(self, request: Request, pk: str | None = None) -> Response:
         """Publishes the draft as the next version; refused with the report unless valid and sound."""
@@ -140,7 +142,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
             ),
         ],
         request={"application/json": OpenApiTypes.OBJECT, "application/xml": OpenApiTypes.STR},
-        responses={201: PatternSerializer, 400: DOCUMENT_ERROR},
+        responses={201: PatternSerializer, 400: DocumentErrorSerializer},
     )
     @action(detail=False, methods=["post"], url_path="import", url_name="import")
     def import_document(self, request: Request) -> Response:
