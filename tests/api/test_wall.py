@@ -1,0 +1,178 @@
+"""Every endpoint against every persona: the organisation wall and the role rules.
+
+An outsider (an engineer elsewhere) gets 404 for each of our objects and never
+sees them in a list; an operator reads but gets 403 on every write; a request
+without credentials gets 401 or 403; members get through (the positive control
+that shows the 404s are the wall, not a broken URL).
+"""
+
+from dataclasses import dataclass
+from typing import Any
+
+import pytest
+from django.contrib.auth.models import User
+from rest_framework.test import APIClient
+
+from hrc.cobots.models import Cobot
+from hrc.organisations.models import Organisation
+from hrc.patterns import services
+from hrc.patterns.models import PatternModel, PatternVersion
+from tests import factories
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    method: str
+    path: str
+    write: bool
+    body: Any = None
+
+    def call(self, client: APIClient, ids: dict[str, int]) -> Any:
+        return getattr(client, self.method)(self.path.format(**ids), self.body, format="json")
+
+    def __str__(self) -> str:
+        return f"{self.method.upper()} {self.path}"
+
+
+PATTERN_BODY = {"name": "Overwritten", "draft": factories.valid_document()}
+COBOT_BODY = {"name": "overwritten", "driver": "simulated", "endpoint": "opc.tcp://x:4840"}
+
+OBJECT_ENDPOINTS = [
+    Endpoint("get", "/api/organisations/{organisation}/", write=False),
+    Endpoint("get", "/api/patterns/{pattern}/", write=False),
+    Endpoint("put", "/api/patterns/{pattern}/", write=True, body=PATTERN_BODY),
+    Endpoint("patch", "/api/patterns/{pattern}/", write=True, body={"name": "Overwritten"}),
+    Endpoint("delete", "/api/patterns/{pattern}/", write=True),
+    Endpoint("post", "/api/patterns/{pattern}/check/", write=False),
+    Endpoint("post", "/api/patterns/{pattern}/publish/", write=True),
+    Endpoint("get", "/api/patterns/{pattern}/versions/", write=False),
+    Endpoint("get", "/api/patterns/{pattern}/export/", write=False),
+    Endpoint("get", "/api/patterns/{pattern}/export/?format=pnml", write=False),
+    Endpoint("get", "/api/pattern-versions/{version}/", write=False),
+    Endpoint("get", "/api/pattern-versions/{version}/export/", write=False),
+    Endpoint("get", "/api/cobots/{cobot}/", write=False),
+    Endpoint("put", "/api/cobots/{cobot}/", write=True, body=COBOT_BODY),
+    Endpoint("patch", "/api/cobots/{cobot}/", write=True, body={"name": "overwritten"}),
+    Endpoint("delete", "/api/cobots/{cobot}/", write=True),
+]
+LIST_ENDPOINTS = ["/api/organisations/", "/api/patterns/", "/api/pattern-versions/", "/api/cobots/"]
+CREATE_ENDPOINTS = [
+    Endpoint("post", "/api/patterns/", write=True, body=PATTERN_BODY),
+    Endpoint("post", "/api/patterns/import/", write=True, body=factories.valid_document()),
+    Endpoint("post", "/api/cobots/", write=True, body=COBOT_BODY),
+]
+ALL_ENDPOINTS = [
+    *OBJECT_ENDPOINTS,
+    *CREATE_ENDPOINTS,
+    *(Endpoint("get", path, write=False) for path in LIST_ENDPOINTS),
+    Endpoint("get", "/api/organisations/me/", write=False),
+]
+
+
+@dataclass
+class World:
+    """One of everything in the home organisation."""
+
+    organisation: Organisation
+    pattern: PatternModel
+    version: PatternVersion
+    cobot: Cobot
+
+    @property
+    def ids(self) -> dict[str, int]:
+        return {
+            "organisation": self.organisation.pk,
+            "pattern": self.pattern.pk,
+            "version": self.version.pk,
+            "cobot": self.cobot.pk,
+        }
+
+    def assert_untouched(self) -> None:
+        self.pattern.refresh_from_db()
+        self.cobot.refresh_from_db()
+        assert self.pattern.name == "Hand-over"
+        assert self.cobot.name == "cobot1"
+        assert list(self.pattern.versions.values_list("number", flat=True)) == [1]
+
+
+@pytest.fixture
+def world(organisation: Organisation, engineer: User) -> World:
+    pattern = factories.make_pattern(organisation, name="Hand-over", created_by=engineer)
+    version = services.publish_pattern(pattern, published_by=engineer)
+    return World(organisation, pattern, version, factories.make_cobot(organisation, name="cobot1"))
+
+
+@pytest.mark.parametrize("endpoint", OBJECT_ENDPOINTS, ids=str)
+def test_an_outsider_gets_404_for_every_object_of_another_organisation(
+    outsider_client: APIClient, world: World, endpoint: Endpoint
+) -> None:
+    assert endpoint.call(outsider_client, world.ids).status_code == 404
+    world.assert_untouched()
+
+
+@pytest.mark.parametrize("path", LIST_ENDPOINTS)
+def test_an_outsider_sees_nothing_of_another_organisation_in_lists(
+    outsider_client: APIClient, world: World, path: str
+) -> None:
+    response = outsider_client.get(path)
+    assert response.status_code == 200
+    if path == "/api/organisations/":  # the outsider's own organisation, and only that
+        assert [o["name"] for o in response.data["results"]] == ["Other plant"]
+    else:
+        assert response.data["results"] == []
+
+
+@pytest.mark.parametrize("path", LIST_ENDPOINTS)
+def test_a_user_without_membership_sees_empty_lists(
+    loner_client: APIClient, world: World, path: str
+) -> None:
+    response = loner_client.get(path)
+    assert response.status_code == 200
+    assert response.data["count"] == 0
+
+
+@pytest.mark.parametrize(
+    "endpoint", [e for e in OBJECT_ENDPOINTS + CREATE_ENDPOINTS if e.write], ids=str
+)
+def test_an_operator_gets_403_on_every_write(
+    operator_client: APIClient, world: World, endpoint: Endpoint
+) -> None:
+    response = endpoint.call(operator_client, world.ids)
+    assert response.status_code == 403
+    assert "engineers and admins" in response.data["detail"]
+    world.assert_untouched()
+    assert PatternModel.objects.count() == 1
+    assert Cobot.objects.count() == 1
+
+
+@pytest.mark.parametrize("endpoint", [e for e in OBJECT_ENDPOINTS if not e.write], ids=str)
+def test_an_operator_reads_every_object_of_their_organisation(
+    operator_client: APIClient, world: World, endpoint: Endpoint
+) -> None:
+    assert endpoint.call(operator_client, world.ids).status_code == 200
+
+
+@pytest.mark.parametrize("path", LIST_ENDPOINTS)
+def test_an_operator_lists_their_organisations_objects(
+    operator_client: APIClient, world: World, path: str
+) -> None:
+    assert operator_client.get(path).data["count"] == 1
+
+
+@pytest.mark.parametrize("endpoint", ALL_ENDPOINTS, ids=str)
+def test_without_credentials_every_endpoint_is_refused(
+    anonymous_client: APIClient, world: World, endpoint: Endpoint
+) -> None:
+    assert endpoint.call(anonymous_client, world.ids).status_code in (401, 403)
+    world.assert_untouched()
+
+
+@pytest.mark.parametrize(
+    "endpoint",
+    [e for e in OBJECT_ENDPOINTS if e.write and e.method != "delete"] + CREATE_ENDPOINTS,
+    ids=str,
+)
+def test_an_engineer_writes_through_every_write_endpoint(
+    engineer_client: APIClient, world: World, endpoint: Endpoint
+) -> None:
+    assert endpoint.call(engineer_client, world.ids).status_code in (200, 201)

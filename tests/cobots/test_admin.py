@@ -1,0 +1,63 @@
+import pytest
+from django.test import Client
+
+from hrc.cobots.models import Cobot
+from hrc.organisations import services as organisation_services
+from hrc.organisations.models import Organisation
+from tests import factories
+
+
+@pytest.fixture
+def staff_client(db: None) -> Client:
+    superuser = organisation_services.provision_user(
+        "root", password="a-test-password", is_staff=True, is_superuser=True
+    )
+    client = Client()
+    client.force_login(superuser)
+    return client
+
+
+def test_cobot_pages_render(staff_client: Client, organisation: Organisation) -> None:
+    cobot = factories.make_cobot(organisation)
+    for url in [
+        "/admin/cobots/cobot/",
+        "/admin/cobots/cobot/add/",
+        f"/admin/cobots/cobot/{cobot.pk}/change/",
+        "/admin/cobots/cobot/?driver__exact=simulated",
+        "/admin/cobots/cobot/?q=cobot",
+    ]:
+        assert staff_client.get(url).status_code == 200, url
+
+
+def test_the_add_page_explains_where_credentials_come_from(staff_client: Client) -> None:
+    page = staff_client.get("/admin/cobots/cobot/add/").content.decode()
+    assert "Never type the secret itself here" in page
+
+
+def test_the_admin_registers_a_cobot(staff_client: Client, organisation: Organisation) -> None:
+    data = {
+        "organisation": str(organisation.pk),
+        "name": "ur10",
+        "is_active": "on",
+        "driver": "ur",
+        "endpoint": "opc.tcp://ur10:4840",
+        "credentials_source": "env:UR10_PASSWORD",
+    }
+    response = staff_client.post("/admin/cobots/cobot/add/", data)
+    assert response.status_code == 302, response.content.decode()[:3000]
+    assert Cobot.objects.get(name="ur10").credentials_source == "env:UR10_PASSWORD"
+
+
+def test_the_admin_refuses_a_secret_as_credentials_source(
+    staff_client: Client, organisation: Organisation
+) -> None:
+    data = {
+        "organisation": str(organisation.pk),
+        "name": "ur10",
+        "driver": "ur",
+        "endpoint": "opc.tcp://ur10:4840",
+        "credentials_source": "hunter2",
+    }
+    response = staff_client.post("/admin/cobots/cobot/add/", data)
+    assert response.status_code == 200
+    assert not Cobot.objects.exists()

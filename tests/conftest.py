@@ -1,0 +1,94 @@
+"""Personas and API clients shared by the tests of the Django apps.
+
+The home organisation has an operator, an engineer and an admin. The
+outsider is an engineer of another organisation: able to write at home, so
+a 404 on our objects shows the wall, not a missing role. The loner belongs
+to no organisation.
+"""
+
+import pytest
+from django.contrib.auth.models import User
+from rest_framework.test import APIClient
+
+from hrc.organisations.choices import Role
+from hrc.organisations.models import Organisation
+from hrc.patterns.models import PatternModel
+from tests import factories
+
+
+@pytest.fixture
+def organisation(db: None) -> Organisation:
+    return factories.make_organisation("Home plant")
+
+
+@pytest.fixture
+def other_organisation(db: None) -> Organisation:
+    return factories.make_organisation("Other plant")
+
+
+@pytest.fixture
+def operator(organisation: Organisation) -> User:
+    return factories.make_member(organisation, Role.OPERATOR, "olivia-operator")
+
+
+@pytest.fixture
+def engineer(organisation: Organisation) -> User:
+    return factories.make_member(organisation, Role.ENGINEER, "erik-engineer")
+
+
+@pytest.fixture
+def admin(organisation: Organisation) -> User:
+    return factories.make_member(organisation, Role.ADMIN, "ada-admin")
+
+
+@pytest.fixture
+def outsider(other_organisation: Organisation) -> User:
+    return factories.make_member(other_organisation, Role.ENGINEER, "oscar-outsider")
+
+
+@pytest.fixture
+def loner(db: None) -> User:
+    return factories.make_user("lena-loner")
+
+
+def _client_for(user: User | None) -> APIClient:
+    client = APIClient()
+    if user is not None:
+        client.force_authenticate(user)
+    return client
+
+
+@pytest.fixture
+def operator_client(operator: User) -> APIClient:
+    return _client_for(operator)
+
+
+@pytest.fixture
+def engineer_client(engineer: User) -> APIClient:
+    return _client_for(engineer)
+
+
+@pytest.fixture
+def admin_client(admin: User) -> APIClient:
+    return _client_for(admin)
+
+
+@pytest.fixture
+def outsider_client(outsider: User) -> APIClient:
+    return _client_for(outsider)
+
+
+@pytest.fixture
+def loner_client(loner: User) -> APIClient:
+    return _client_for(loner)
+
+
+@pytest.fixture
+def anonymous_client() -> APIClient:
+    return _client_for(None)
+
+
+@pytest.fixture
+def pattern(organisation: Organisation, engineer: User) -> PatternModel:
+    """A valid, sound, unpublished pattern of the home organisation."""
+    return factories.make_pattern(organisation, name="Hand-over", created_by=engineer)

@@ -1,0 +1,88 @@
+import pytest
+from django.contrib.auth.models import User
+from django.core.exceptions import ValidationError
+
+from hrc.organisations import services
+from hrc.organisations.choices import Role
+from hrc.organisations.models import Membership, Organisation
+from hrc.organisations.selectors import (
+    may_write_in,
+    organisations_of,
+    role_in,
+    writable_organisations,
+)
+from tests import factories
+
+
+def test_a_user_can_be_a_member_only_once_per_organisation(
+    organisation: Organisation, engineer: User
+) -> None:
+    with pytest.raises(ValidationError):
+        services.add_member(organisation, engineer, Role.OPERATOR)
+    assert Membership.objects.filter(user=engineer).count() == 1
+
+
+def test_the_same_user_may_join_a_second_organisation(
+    engineer: User, other_organisation: Organisation
+) -> None:
+    services.add_member(other_organisation, engineer, Role.OPERATOR)
+    assert role_in(engineer, other_organisation.pk) == Role.OPERATOR
+
+
+def test_an_unknown_role_is_refused(organisation: Organisation) -> None:
+    with pytest.raises(ValidationError):
+        services.add_member(organisation, factories.make_user(), "superhero")
+
+
+def test_change_role_changes_what_the_member_may_write(
+    organisation: Organisation, operator: User
+) -> None:
+    assert not may_write_in(operator, organisation.pk)
+    membership = Membership.objects.get(user=operator)
+    services.change_role(membership, Role.ENGINEER)
+    assert may_write_in(operator, organisation.pk)
+
+
+def test_a_taken_slug_is_refused(organisation: Organisation) -> None:
+    with pytest.raises(ValidationError):
+        services.create_organisation(name="Copy", slug=organisation.slug)
+
+
+def test_team_members_must_belong_to_the_teams_organisation(
+    organisation: Organisation, engineer: User, outsider: User
+) -> None:
+    team = services.create_team(organisation, name="Early shift")
+    stranger = Membership.objects.get(user=outsider)
+    with pytest.raises(ValidationError):
+        services.set_team_members(team, [stranger])
+    services.set_team_members(team, [Membership.objects.get(user=engineer)])
+    assert list(team.members.values_list("user__username", flat=True)) == [engineer.username]
+
+
+def test_team_names_are_unique_within_an_organisation_only(
+    organisation: Organisation, other_organisation: Organisation
+) -> None:
+    services.create_team(organisation, name="Cell 1")
+    services.create_team(other_organisation, name="Cell 1")
+    with pytest.raises(ValidationError):
+        services.create_team(organisation, name="Cell 1")
+
+
+@pytest.mark.django_db
+def test_provision_user_resets_the_password_and_flags_of_an_existing_user() -> None:
+    first = services.provision_user("dana", password="one-password", is_staff=True)
+    again = services.provision_user("dana", password="two-password")
+    again.refresh_from_db()
+    assert again.pk == first.pk
+    assert again.check_password("two-password")
+    assert not again.check_password("one-password")
+    assert not again.is_staff
+
+
+def test_selectors_see_only_the_users_own_organisations(
+    organisation: Organisation, other_organisation: Organisation, operator: User, engineer: User
+) -> None:
+    assert list(organisations_of(operator)) == [organisation]
+    assert list(writable_organisations(operator)) == []
+    assert list(writable_organisations(engineer)) == [organisation]
+    assert role_in(engineer, other_organisation.pk) is None
