@@ -20,6 +20,7 @@ $(STAMP): requirements/lock.txt
 install: $(STAMP)  ## create .venv and install the locked dependencies (idempotent)
 
 demo: install  ## load the example library into a demo organisation and serve on 127.0.0.1:8000
+	@mkdir -p var  # the embedded SQLite database lives here when DATABASE_URL is unset
 	$(PY) manage.py migrate --noinput
 	$(PY) manage.py load_demo
 	$(PY) manage.py runserver 127.0.0.1:8000
