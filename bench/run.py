@@ -185,7 +185,7 @@ def measure(family: str, size: int, settings: Settings, woflan_skip: str | None)
             "sound": report.sound,
             "error_codes": sorted({issue.code for issue in errors}),
             "witness": any(issue.witness for issue in unsound) if unsound else None,
-            "witness_length": max((len(i.witness) for i in unsound if i.witness), default=None),
+            "witness_length": next((len(i.witness) for i in unsound if i.witness), None),
             "markings": _markings(stats),
             "stats": stats,
         }
@@ -274,6 +274,14 @@ def machine() -> dict[str, Any]:
     return info
 
 
+def _load() -> list[float] | None:
+    """The 1, 5 and 15 minute load averages, where the system has them."""
+    try:
+        return [round(value, 2) for value in os.getloadavg()]
+    except OSError:
+        return None
+
+
 def _cpu_model() -> str | None:
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -334,6 +342,8 @@ def table(rows: Sequence[Mapping[str, Any]]) -> str:
             our_time = _duration(ours["seconds"])
             verdict = _verdict(ours["sound"])
             witness = {True: "yes", False: "NO", None: "-"}[ours["witness"]]
+            if ours["witness"] and ours["witness_length"] is not None:
+                witness += f" ({ours['witness_length']})"  # firings in the first witness
             peak = ours["peak_memory_bytes"]
             memory = "-" if peak is None else f"{peak / 2**20:.1f} MiB"
             markings = "-" if ours["markings"] is None else str(ours["markings"])
@@ -389,15 +399,31 @@ def table(rows: Sequence[Mapping[str, Any]]) -> str:
     return "\n".join(out)
 
 
+def _summary(row: Mapping[str, Any]) -> str:
+    """One line per net while the benchmark runs, so a slow Woflan shows where it is."""
+    ours, woflan = row["ours"], row["woflan"]
+    text = f"ours {'timed out' if ours['timed_out'] else _duration(ours['seconds'])}"
+    if woflan is not None:
+        if woflan["timed_out"]:
+            text += f", woflan > {woflan['timeout']:g} s" + (
+                " (skipped)" if woflan.get("skipped") else ""
+            )
+        else:
+            text += f", woflan {_duration(woflan['seconds'])}"
+    return text
+
+
 def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
     """Measures every net and writes the result files; returns the result document."""
     started = datetime.now(UTC)
+    load_before = _load()
     rows = []
     woflan_overran: dict[str, str] = {}
     for size in sorted(settings.sizes):  # small first, so a Woflan timeout can skip larger ones
         for family in settings.families:
             progress(f"  {family}-{size} ...")
             row = measure(family, size, settings, woflan_overran.get(family))
+            progress(f"    {_summary(row)}")
             woflan = row["woflan"]
             if woflan is not None and woflan["timed_out"] and family not in woflan_overran:
                 woflan_overran[family] = f"timed out at {size} transitions"
@@ -407,6 +433,9 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "started": started.isoformat(timespec="seconds"),
         "seconds": (datetime.now(UTC) - started).total_seconds(),
         "machine": machine(),
+        # Other work on the machine slows both checkers (Woflan most, as it runs
+        # longest); the load average says how quiet the run was.
+        "load_average": {"before": load_before, "after": _load()},
         "settings": {
             "families": settings.families,
             "sizes": sorted(settings.sizes),
@@ -484,6 +513,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     result = run(settings, progress=lambda line: print(line, file=sys.stderr, flush=True))
     print(table(result["nets"]))
+    load, cpus = result["load_average"]["before"], result["machine"]["cpu_count"]
+    if load is not None and cpus and load[0] >= cpus:
+        print(
+            f"\nnote: load average {load[0]:g} on {cpus} CPUs when the run started: "
+            "other work shared the machine, so the times are noisy"
+        )
     flagged = [row for row in result["nets"] if row["flags"]]
     print(
         f"\n{len(result['nets'])} nets in {result['seconds']:.0f} s; "
