@@ -5,6 +5,7 @@ nodes; ids starting with `p` are places, anything else a transition. Tasks
 get performers from `performers`; everything else is silent.
 """
 
+import itertools
 import json
 from pathlib import Path
 from typing import Any
@@ -33,7 +34,7 @@ def process(
             bucket = places if node.startswith("p") else transitions
             if node not in bucket:
                 bucket.append(node)
-        arcs += [[a, b] for a, b in zip(nodes, nodes[1:], strict=False) if [a, b] not in arcs]
+        arcs += [[a, b] for a, b in itertools.pairwise(nodes) if [a, b] not in arcs]
     return {
         "id": process_id,
         "workpiece": workpiece,
@@ -69,7 +70,9 @@ def document(
     return data
 
 
-def two_lanes(constraints: list[tuple[str, str, str]], declared: str | None = None) -> dict[str, Any]:
+def two_lanes(
+    constraints: list[tuple[str, str, str]], declared: str | None = None
+) -> dict[str, Any]:
     """An AND-split into a cobot lane (tc1→tc2→tc3) and an operator lane (to1→to2), joined again."""
     lanes = process(
         "N",

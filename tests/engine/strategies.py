@@ -13,11 +13,34 @@ from hypothesis import strategies as st
 ACTORS = {"c1": "cobot", "c2": "cobot", "o1": "operator", "o2": "operator"}
 JSON_VALUES = st.recursive(
     st.none() | st.booleans() | st.integers(-1000, 1000) | st.text(max_size=8),
-    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3),
+    lambda inner: (
+        st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3)
+    ),
     max_leaves=6,
 )
 EXTRA_KEYS = st.text(min_size=1, max_size=6).filter(
-    lambda k: k not in {"id", "type", "tokens", "performer", "label", "from", "to", "workpiece", "actors", "places", "transitions", "arcs", "format", "name", "declared_pattern", "processes", "constraints"}
+    lambda k: (
+        k
+        not in {
+            "id",
+            "type",
+            "tokens",
+            "performer",
+            "label",
+            "from",
+            "to",
+            "workpiece",
+            "actors",
+            "places",
+            "transitions",
+            "arcs",
+            "format",
+            "name",
+            "declared_pattern",
+            "processes",
+            "constraints",
+        }
+    )
 )
 EXTRAS = st.dictionaries(EXTRA_KEYS, JSON_VALUES, max_size=2)
 
@@ -35,7 +58,9 @@ class _Builder:
 
     def transition(self, performer: str | None) -> str:
         transition = f"t{len(self.transitions) + 1}"
-        self.transitions.append({"id": transition, **({"performer": performer} if performer else {})})
+        self.transitions.append(
+            {"id": transition, **({"performer": performer} if performer else {})}
+        )
         return transition
 
     def arc(self, source: str, target: str) -> None:
@@ -44,7 +69,9 @@ class _Builder:
 
 @st.composite
 def _block(draw: st.DrawFn, builder: _Builder, entry: str, exit_: str, depth: int) -> None:
-    kind = draw(st.sampled_from(["task", "task", "seq", "and", "xor", "loop"] if depth < 2 else ["task"]))
+    kind = draw(
+        st.sampled_from(["task", "task", "seq", "and", "xor", "loop"] if depth < 2 else ["task"])
+    )
     if kind == "task":
         task = builder.transition(draw(st.sampled_from(sorted(ACTORS))))
         builder.arc(entry, task)

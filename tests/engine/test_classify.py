@@ -37,7 +37,10 @@ def test_mixed_constraint_types_fit_no_pattern_and_say_why() -> None:
 
     assert report.patterns == ()
     warning = next(w for w in report.warnings if w.code == "no-pattern")
-    assert "every constraint must be a time constraint, the model has space constraints" in warning.message
+    assert (
+        "every constraint must be a time constraint, the model has space constraints"
+        in warning.message
+    )
 
 
 def test_a_single_actor_type_is_no_pattern() -> None:
@@ -53,7 +56,9 @@ def test_coexistence_needs_disjoint_actors_and_no_constraints() -> None:
     first = process("N1", "p11 tc1 p12", performers={"tc1": "c"}, workpiece="w1")
     second = process("N2", "p21 to1 p22", performers={"to1": "o"}, workpiece="w2")
 
-    report = check_document(document(first, second, constraints=[("tc1", "to1", "time")], declared="coexistence"))
+    report = check_document(
+        document(first, second, constraints=[("tc1", "to1", "time")], declared="coexistence")
+    )
 
     mismatch = next(e for e in report.errors if e.code == "pattern-mismatch")
     assert "allows no constraints, the model has 1" in mismatch.message
@@ -73,6 +78,9 @@ def test_a_declared_pattern_that_does_not_hold_is_an_error_naming_the_failed_req
 
     mismatch = next(e for e in report.errors if e.code == "pattern-mismatch")
     assert "declared collaboration" in mismatch.message
-    assert "every constraint must be a func constraint, the model has time constraints" in mismatch.message
+    assert (
+        "every constraint must be a func constraint, the model has time constraints"
+        in mismatch.message
+    )
     assert "(it is synchronized)" in mismatch.message
     assert report.sound is True  # the behaviour is still decided

@@ -35,7 +35,7 @@ def test_the_shipped_examples_are_written_back_byte_for_byte() -> None:
     ("text", "fragment"),
     [
         ("{not json", "not JSON: Expecting property name"),
-        (b"{\"name\": \"\xc3\x28\"}", "not UTF-8"),
+        (b'{"name": "\xc3\x28"}', "not UTF-8"),
         ("[]", "must be a JSON object, got a list"),
         ('{"format": "bpmn"}', '"format": "hrc-pattern/1", got "bpmn"'),
         ('{"format": "hrc-pattern/1", "processes": []}', "no process"),
@@ -59,7 +59,8 @@ def _shape(change: dict[str, Any]) -> list[str]:
             target = target[int(key)] if key.isdigit() else target[key]
         target[int(last) if last.isdigit() else last] = value
     report = check_document(data)
-    assert report.valid is False and report.sound is None
+    assert report.valid is False
+    assert report.sound is None
     return [issue.message for issue in report.errors]
 
 
@@ -68,7 +69,10 @@ def _shape(change: dict[str, Any]) -> list[str]:
     [
         ({"actors.0.type": "robot"}, 'actors[0].type must be "cobot" or "operator", got "robot"'),
         ({"actors.0.id": 7}, "actors[0].id must be a non-empty string, got the number 7"),
-        ({"processes.0.places.0.tokens": -1}, "processes[0].places[0].tokens must be a whole number ≥ 0"),
+        (
+            {"processes.0.places.0.tokens": -1},
+            "processes[0].places[0].tokens must be a whole number ≥ 0",
+        ),
         ({"processes.0.places.0.tokens": True}, "tokens must be a whole number ≥ 0, got true"),
         ({"processes.0.arcs.0": ["p1"]}, "processes[0].arcs[0] must be a pair of node ids"),
         ({"processes.0.transitions.0.performer": 3}, "performer must be a string"),
@@ -77,7 +81,9 @@ def _shape(change: dict[str, Any]) -> list[str]:
         ({"name": ["x"]}, "name must be a string"),
     ],
 )
-def test_wrong_shapes_are_format_errors_that_name_the_place(change: dict[str, Any], fragment: str) -> None:
+def test_wrong_shapes_are_format_errors_that_name_the_place(
+    change: dict[str, Any], fragment: str
+) -> None:
     messages = _shape(change)
 
     assert any(fragment in message for message in messages), messages

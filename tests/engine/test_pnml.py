@@ -152,9 +152,18 @@ def tricky_pattern() -> Pattern:
                     ("p2", "a1"),
                     ("1st net", "t 2"),
                     ("ghost", "x:y"),
+                    # Not a node here, but the id the writer generates for place "1".
+                    ("p3", "t 2"),
                 ),
             ),
-            Process("N2", None, (), (Place("p2", extra={"label": "dangling above"}),), (), ()),
+            Process(
+                "N2",
+                None,
+                (),
+                (Place("p2", extra={"label": "an arc of 1st net ends here"}),),
+                (),
+                (),
+            ),
         ),
         constraints=(Constraint("t1", "t 2", "space"), Constraint("t1", "t1", "colour")),
         declared_pattern=None,
@@ -277,7 +286,8 @@ _declared = st.none() | st.sampled_from(PATTERN_NAMES)
 
 def _pick(draw: st.DrawFn, choices: list[str]) -> str:
     """Mostly one of `choices` (an id that exists), sometimes any id."""
-    if choices and draw(_coin):
+    existing: bool = draw(_coin)
+    if choices and existing:
         return choices[draw(_index) % len(choices)]
     return draw(_ids)
 
@@ -288,7 +298,7 @@ def _process(draw: st.DrawFn, actor_ids: list[str]) -> Process:
         replace(t, performer=_pick(draw, actor_ids)) if draw(_coin) else t
         for t in draw(_transitions)
     ]
-    nodes = [node.id for node in [*places, *transitions]]
+    nodes = [p.id for p in places] + [t.id for t in transitions]
     return Process(
         id=draw(_ids),
         workpiece=draw(_optional_text),
@@ -560,7 +570,7 @@ def own_file(changes: list[tuple[str, str]]) -> str:
         ),
         pytest.param(
             net("<referencePlace id='r1' ref='r2'/><referencePlace id='r2' ref='r1'/>"),
-            ["cycle"],
+            ["References r1, r2 refer to each other in a cycle"],
             ["r1", "r2"],
             id="reference-cycle",
         ),
@@ -625,6 +635,15 @@ def test_an_external_entity_is_never_read() -> None:
             id="unknown-version",
         ),
         pytest.param(
+            [('<page id="N">', "<page>")], ["A <page> has no id"], [], id="page-without-id"
+        ),
+        pytest.param(
+            [("</page>", '</page><place id="stray"/>')],
+            ["outside any <page>"],
+            ["net1"],
+            id="place-outside-page",
+        ),
+        pytest.param(
             [('"format": "hrc-pattern/1"', '"format": "hrc-pattern/9"')],
             ["hrc-pattern/1", "hrc-pattern/9"],
             [],
@@ -656,6 +675,14 @@ def test_broken_hrc_data_is_a_format_error(
     for fragment in fragments:
         assert fragment in str(raised)
     assert {element for issue in raised.issues for element in issue.elements} >= set(elements)
+
+
+def test_a_reference_cycle_is_reported_once() -> None:
+    text = net(
+        "<referencePlace id='r0' ref='r1'/>"
+        "<referencePlace id='r1' ref='r2'/><referencePlace id='r2' ref='r1'/>"
+    )
+    assert [issue.elements for issue in format_error(text).issues] == [("r1", "r2")]
 
 
 def test_every_problem_in_a_file_is_reported_at_once() -> None:

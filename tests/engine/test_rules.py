@@ -104,8 +104,18 @@ CASES: list[tuple[str, Callable[[Doc], None], str, set[str]]] = [
     ("actor in no process", _unassigned_actor, "unassigned-actor", {"c2"}),
     ("assigned actor performs nothing", _idle_actor, "idle-actor", {"o2"}),
     ("constraint joins a task to itself", _self_constraint, "constraint-self", {"tc1"}),
-    ("constraint on a silent transition", _unperformed_constraint, "constraint-unperformed", {"t1"}),
-    ("constraint between one actor's tasks", _same_performer_constraint, "constraint-same-performer", {"tc1", "tc3"}),
+    (
+        "constraint on a silent transition",
+        _unperformed_constraint,
+        "constraint-unperformed",
+        {"t1"},
+    ),
+    (
+        "constraint between one actor's tasks",
+        _same_performer_constraint,
+        "constraint-same-performer",
+        {"tc1", "tc3"},
+    ),
     ("constraint of an unknown type", _constraint_type, "constraint-type", {"tc1", "to2"}),
     ("process with two sink places", _two_sinks, "not-workflow-net", {"p9", "p10"}),
     ("node on no path from source to sink", _stray_cycle, "not-workflow-net", {"p10", "t3"}),
@@ -115,7 +125,9 @@ CASES: list[tuple[str, Callable[[Doc], None], str, set[str]]] = [
 ]
 
 
-@pytest.mark.parametrize(("change", "code", "elements"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+@pytest.mark.parametrize(
+    ("change", "code", "elements"), [c[1:] for c in CASES], ids=[c[0] for c in CASES]
+)
 def test_each_broken_rule_is_reported_with_its_code_and_elements(
     change: Callable[[Doc], None], code: str, elements: set[str]
 ) -> None:
