@@ -16,6 +16,11 @@ PIPE, ...) as one process per `<net>`, without actors. Both ways build an
 the same shape checks as a JSON one and fails with the same `FormatError`.
 Arcs are kept as written: an arc to a node that does not exist is the rules'
 `unknown-node`, as in a JSON document.
+
+Places have no label in `hrc-pattern/1`: a place's PNML name is the `name` in
+its extras where it has one, else its id, and a foreign place whose name
+differs from its id keeps it there. Editor positions `x`, `y` in the extras
+are also written as standard graphics, and foreign graphics are read into them.
 """
 
 import json
@@ -263,31 +268,32 @@ def _attribute_safe(value: str) -> str:
 # Reading ---------------------------------------------------------------------------------
 
 
-def _parse_xml(text: str | bytes) -> ET.Element:
-    def refuse(message: str) -> FormatError:
-        return FormatError([error("format", message)])
+def _refuse(message: str) -> FormatError:
+    return FormatError([error("format", message)])
 
+
+def _parse_xml(text: str | bytes) -> ET.Element:
     try:
         return cast(
             ET.Element,
             _safe_fromstring(text, forbid_dtd=True, forbid_entities=True, forbid_external=True),
         )
     except DTDForbidden:
-        raise refuse(
+        raise _refuse(
             "The document has a DTD (<!DOCTYPE ...>), which is refused: PNML needs none, and a DTD"
             " can define entities that expand without limit (an XML bomb) or read other files"
             " (external entities)."
         ) from None
     except EntitiesForbidden as exc:
-        raise refuse(f"The document declares the entity {exc.name!r}, which is refused.") from None
+        raise _refuse(f"The document declares the entity {exc.name!r}, which is refused.") from None
     except ExternalReferenceForbidden:
-        raise refuse("The document refers to an external resource, which is refused.") from None
+        raise _refuse("The document refers to an external resource, which is refused.") from None
     except DefusedXmlException as exc:
-        raise refuse(f"The document was refused as unsafe XML: {exc}.") from None
+        raise _refuse(f"The document was refused as unsafe XML: {exc}.") from None
     except ET.ParseError as exc:
-        raise refuse(f"The document is not XML: {exc}.") from None
+        raise _refuse(f"The document is not XML: {exc}.") from None
     except UnicodeError:
-        raise refuse("The document is not valid Unicode text.") from None
+        raise _refuse("The document is not valid Unicode text.") from None
 
 
 @dataclass
@@ -340,28 +346,24 @@ class _Reader:
             )
         document = self._own_document(nets[0]) if own else self._foreign_document(nets)
         if self.issues:
-            raise FormatError(self.issues)
+            raise FormatError(list(dict.fromkeys(self.issues)))
         return document
 
     def _nets(self) -> list[ET.Element]:
         namespace, _, local = self.root.tag.rpartition("}")
         namespace = namespace.removeprefix("{")
         if local != "pnml":
-            raise FormatError(
-                [
-                    error(
-                        "format",
-                        f"The root element is <{local}>, not <pnml>: this is not a PNML document.",
-                    )
-                ]
+            raise _refuse(
+                f"The root element is <{local}>, not <pnml>: this is not a PNML document."
             )
         if namespace not in ("", PNML_NAMESPACE):
-            message = f"The <pnml> element is in namespace {namespace!r}; PNML is {PNML_NAMESPACE!r} (or none)."
-            raise FormatError([error("format", message)])
+            raise _refuse(
+                f"The <pnml> element is in namespace {namespace!r}; PNML is {PNML_NAMESPACE!r} (or none)."
+            )
         self.ns = f"{{{namespace}}}" if namespace else ""
         nets = self._children(self.root, "net")
         if not nets:
-            raise FormatError([error("format", "The PNML document has no <net>.")])
+            raise _refuse("The PNML document has no <net>.")
         for net in nets:
             self._check_net(net)
         if self.issues:
@@ -385,7 +387,11 @@ class _Reader:
         stray = [child for child in net if self._kind(child) not in (None, "page")]
         if stray:
             self.fail(f"Net {net_id} has places, transitions or arcs outside any <page>.", net_id)
-        pages = [(page, self._contents(page, own=True)) for page in self._children(net, "page")]
+        pages = [
+            (page, self._contents(page, own=True))
+            for page in self._children(net, "page")
+            if self._id(page, "A <page>")
+        ]
         names = self._names([content for _, content in pages])
         document: Json = {}
         name = self._label(net)
@@ -504,7 +510,8 @@ class _Reader:
                 self.fail(f"Reference {current} refers to {target}, which does not exist.", current)
                 return None
             if target in seen:
-                self.fail(f"References {' -> '.join([*seen, target])} form a cycle.", *seen)
+                cycle = sorted(seen[seen.index(target) :])  # the same issue from each member
+                self.fail(f"References {', '.join(cycle)} refer to each other in a cycle.", *cycle)
                 return None
             if _REFERENCE_KINDS[self._kind(references[target]) or ""] != wanted:
                 self.fail(
