@@ -4,7 +4,8 @@ The net is first reduced (`reduction.reduce_net`), then its reachable
 markings are explored breadth first, so the first marking found with a
 fault is one at the end of a shortest firing sequence, and that sequence,
 expanded back into the original firings, is the witness shown to the
-engineer. Exploration stops at `max_markings`; whatever was found by then is
+engineer (shortest up to the steps the reduction takes at once: a chain of
+firings that nothing can interrupt is shown whole). Exploration stops at `max_markings`; whatever was found by then is
 reported, and a verdict that needs the whole space becomes "too large to
 decide" instead of a hang.
 """
