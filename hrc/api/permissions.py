@@ -6,7 +6,7 @@ below comes after: any member reads, engineers and admins write, operators
 get 403 on writes.
 """
 
-from typing import Any, Protocol
+from typing import Any
 
 from rest_framework.exceptions import PermissionDenied, ValidationError
 from rest_framework.permissions import SAFE_METHODS, BasePermission
@@ -21,10 +21,6 @@ from hrc.organisations.selectors import (
 )
 
 WRITERS_ONLY = "Only engineers and admins of the organisation may change this."
-
-
-class OrganisationOwned(Protocol):
-    organisation_id: int
 
 
 class MembersReadWritersWrite(BasePermission):

@@ -34,6 +34,9 @@ def _inline_management(prefix: str, total: int, initial: int = 0) -> dict[str, s
         "/admin/organisations/membership/",
         "/admin/organisations/team/",
         "/admin/organisations/team/add/",
+        "/admin/organisations/organisation/?q=home",
+        "/admin/organisations/membership/?q=erik&role__exact=engineer",
+        "/admin/organisations/team/?q=erik",
     ],
 )
 def test_admin_pages_render(staff_client: Client, engineer: User, url: str) -> None:

@@ -35,6 +35,8 @@ def test_pattern_pages_render(
         f"/admin/patterns/patternmodel/{pattern.pk}/change/",
         "/admin/patterns/patternversion/",
         f"/admin/patterns/patternversion/{version.pk}/change/",
+        "/admin/patterns/patternmodel/?q=hand",
+        "/admin/patterns/patternversion/?q=erik",
     ]:
         assert staff_client.get(url).status_code == 200, url
 

@@ -12,7 +12,12 @@ from django.db.models import QuerySet
 from django.http import HttpResponse
 from django.utils.text import slugify
 from drf_spectacular.types import OpenApiTypes
-from drf_spectacular.utils import OpenApiParameter, OpenApiResponse, extend_schema
+from drf_spectacular.utils import (
+    OpenApiParameter,
+    OpenApiResponse,
+    extend_schema,
+    extend_schema_view,
+)
 from rest_framework import serializers, status, viewsets
 from rest_framework.decorators import action
 from rest_framework.request import Request
@@ -53,9 +58,19 @@ EXPORT_RESPONSES = {
 }
 
 
-@extend_schema(
-    responses={201: PatternSerializer, 400: DocumentErrorSerializer},
-    methods=["POST", "PUT", "PATCH"],
+DRAFT_WRITE_RESPONSES = {200: PatternSerializer, 400: DocumentErrorSerializer}
+
+
+@extend_schema_view(
+    create=extend_schema(responses={201: PatternSerializer, 400: DocumentErrorSerializer}),
+    update=extend_schema(responses=DRAFT_WRITE_RESPONSES),
+    partial_update=extend_schema(responses=DRAFT_WRITE_RESPONSES),
+    destroy=extend_schema(
+        responses={
+            204: OpenApiResponse(description="Deleted."),
+            409: OpenApiResponse(description="The pattern has published versions; it is kept."),
+        }
+    ),
 )
 class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     """Collaboration patterns of your organisations. Members read; engineers and admins write."""
