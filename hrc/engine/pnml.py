@@ -294,6 +294,8 @@ def _parse_xml(text: str | bytes) -> ET.Element:
         raise _refuse(f"The document is not XML: {exc}.") from None
     except UnicodeError:
         raise _refuse("The document is not valid Unicode text.") from None
+    except LookupError as exc:  # an encoding declaration Python does not know
+        raise _refuse(f"The document is in an unknown encoding: {exc}.") from None
 
 
 @dataclass

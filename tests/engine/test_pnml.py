@@ -483,6 +483,12 @@ def own_file(changes: list[tuple[str, str]]) -> str:
         pytest.param("this is not XML", ["not XML"], [], id="not-xml"),
         pytest.param(b"<pnml><net id='n'>\xff</net></pnml>", ["not XML"], [], id="not-utf8"),
         pytest.param("<pnml><net id='n'></pnml>", ["not XML", "line 1"], [], id="unclosed"),
+        pytest.param(
+            b"<?xml version='1.0' encoding='klingon'?><pnml/>",
+            ["unknown encoding", "klingon"],
+            [],
+            id="unknown-encoding",
+        ),
         pytest.param(BILLION_LAUGHS, ["DTD", "XML bomb"], [], id="billion-laughs"),
         pytest.param(EXTERNAL_ENTITY, ["DTD", "external entit"], [], id="external-entity"),
         pytest.param("<!DOCTYPE pnml><pnml/>", ["DTD"], [], id="doctype"),
