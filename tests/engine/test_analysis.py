@@ -86,7 +86,9 @@ def test_a_loop_that_can_never_leave_is_a_livelock_with_its_way_in() -> None:
     faults = analyse(net).faults
 
     # x is the only way on from a, so the reduction fires it right after s.
-    assert [(f.kind, f.witness) for f in faults if f.kind == "livelock"] == [("livelock", ("s", "x"))]
+    assert [(f.kind, f.witness) for f in faults if f.kind == "livelock"] == [
+        ("livelock", ("s", "x"))
+    ]
     assert [f.transition for f in faults if f.kind == "dead"] == ["z"]
     assert not any(f.kind == "deadlock" for f in faults)
 
