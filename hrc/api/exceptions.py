@@ -26,7 +26,9 @@ class Rejected(exceptions.APIException):
 
     status_code: int = status.HTTP_400_BAD_REQUEST
 
-    def __init__(self, payload: dict[str, Any], status_code: int = status.HTTP_400_BAD_REQUEST):
+    def __init__(
+        self, payload: dict[str, Any], status_code: int = status.HTTP_400_BAD_REQUEST
+    ) -> None:
         super().__init__(str(payload.get("detail", "")))
         self.payload = payload
         self.status_code = status_code
