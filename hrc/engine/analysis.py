@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Literal
 
+from hrc.engine.graph import reachable
 from hrc.engine.petri import Marking, Net
 from hrc.engine.reduction import ReducedNet, reduce_net
 
@@ -231,8 +232,8 @@ def _global_faults(explorer: _Explorer) -> Iterator[Fault]:
     for state, out in explorer.edges.items():
         for _, successor in out:
             reverse[successor].append(state)
-    can_finish = _backward(reverse, [s for s in explorer.order if explorer.is_final(s)])
-    can_end = _backward(reverse, [s for s in explorer.order if not explorer.edges[s]])
+    can_finish = reachable([s for s in explorer.order if explorer.is_final(s)], reverse)
+    can_end = reachable([s for s in explorer.order if not explorer.edges[s]], reverse)
     # A livelock: the case runs on but can neither finish nor even get stuck.
     looping = next((s for s in explorer.order if s not in can_finish and s not in can_end), None)
     if looping is not None:
@@ -246,18 +247,6 @@ def _global_faults(explorer: _Explorer) -> Iterator[Fault]:
     for transition in explorer.net.transitions:
         if transition.id not in fired:
             yield Fault("dead", None, transition=transition.id)
-
-
-def _backward(reverse: dict[_State, list[_State]], targets: list[_State]) -> set[_State]:
-    """Every state from which one of `targets` can be reached."""
-    reached = set(targets)
-    queue = deque(targets)
-    while queue:
-        for predecessor in reverse[queue.popleft()]:
-            if predecessor not in reached:
-                reached.add(predecessor)
-                queue.append(predecessor)
-    return reached
 
 
 def _has_cycle(net: ReducedNet) -> bool:

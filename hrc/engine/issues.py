@@ -5,8 +5,9 @@ from typing import Literal
 
 Severity = Literal["error", "warning"]
 
-# Every code the engine reports, in the order of pattern-format.md.
-CODES = (
+# Codes after which the model is not a well-formed set of workflow nets, so
+# its behaviour (soundness) cannot be decided. In the order of pattern-format.md.
+STRUCTURAL_CODES = (
     "format",
     "duplicate-id",
     "unknown-node",
@@ -19,14 +20,10 @@ CODES = (
     "constraint-same-performer",
     "constraint-type",
     "not-workflow-net",
-    "pattern-mismatch",
-    "unsound",
-    "unbounded",
-    # Warnings.
-    "vacuous-pattern",
-    "no-pattern",
-    "state-space-too-large",
 )
+ERROR_CODES = (*STRUCTURAL_CODES, "pattern-mismatch", "unsound", "unbounded")
+WARNING_CODES = ("vacuous-pattern", "no-pattern", "state-space-too-large")
+CODES = (*ERROR_CODES, *WARNING_CODES)
 
 
 @dataclass(frozen=True)

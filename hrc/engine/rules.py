@@ -5,30 +5,14 @@ succeeded) and reports every broken rule it finds, so an engineer sees all
 of them at once instead of one per save.
 """
 
-from collections import Counter, defaultdict, deque
+from collections import Counter, defaultdict
 from collections.abc import Iterable
 
-from hrc.engine.issues import Issue, error
+from hrc.engine.graph import reachable
+from hrc.engine.issues import STRUCTURAL_CODES, Issue, error
 from hrc.engine.model import CONSTRAINT_TYPES, Pattern, Process
 
-# Codes after which the net is not a well-formed set of workflow nets, so
-# behaviour (soundness) cannot be decided.
-STRUCTURAL_CODES = frozenset(
-    {
-        "format",
-        "duplicate-id",
-        "unknown-node",
-        "arc-kind",
-        "unknown-actor",
-        "unassigned-actor",
-        "idle-actor",
-        "constraint-self",
-        "constraint-unperformed",
-        "constraint-same-performer",
-        "constraint-type",
-        "not-workflow-net",
-    }
-)
+__all__ = ["STRUCTURAL_CODES", "check_rules"]
 
 
 def check_rules(pattern: Pattern) -> list[Issue]:
@@ -206,8 +190,8 @@ def _workflow_net(process: Process) -> Iterable[Issue]:
     for source, target in process.arcs:
         successors[source].append(target)
         predecessors[target].append(source)
-    forward = _reachable(sources[0], successors)
-    backward = _reachable(sinks[0], predecessors)
+    forward = reachable([sources[0]], successors)
+    backward = reachable([sinks[0]], predecessors)
     nodes = [p.id for p in process.places] + [t.id for t in process.transitions]
     counts = Counter(nodes)
     stray = [
@@ -222,17 +206,6 @@ def _workflow_net(process: Process) -> Iterable[Issue]:
             process.id,
             *stray,
         )
-
-
-def _reachable(start: str, edges: dict[str, list[str]]) -> set[str]:
-    seen = {start}
-    queue = deque([start])
-    while queue:
-        for successor in edges[queue.popleft()]:
-            if successor not in seen:
-                seen.add(successor)
-                queue.append(successor)
-    return seen
 
 
 def _listed(ids: list[str], limit: int = 8) -> str:
