@@ -164,6 +164,9 @@ def measure(family: str, size: int, settings: Settings, woflan_skip: str | None)
         seconds, runs = _best_time(ours, settings.runs, SLOW_SECONDS)
     except CheckTimeout:
         row["ours"] = {"seconds": None, "timed_out": True, "timeout": settings.check_timeout}
+    except Exception as exc:
+        # An engine bug on one net is a finding, not a reason to lose the other nets' numbers.
+        row["ours"] = {"seconds": None, "timed_out": False, "error": f"{type(exc).__name__}: {exc}"}
     else:
         peak: int | None
         try:
@@ -236,6 +239,9 @@ def _flags(row: Mapping[str, Any]) -> list[str]:
     """What a reader must look at; the table prints them and the JSON keeps them."""
     flags = []
     ours, woflan = row["ours"], row["woflan"]
+    if ours.get("error"):
+        flags.append("ENGINE-ERROR")
+        return flags + (["WOFLAN-ERROR"] if woflan is not None and woflan.get("error") else [])
     if ours["timed_out"] or (ours["seconds"] is not None and ours["seconds"] >= SLOW_SECONDS):
         flags.append("SLOW")
     if not ours["timed_out"]:
@@ -335,8 +341,9 @@ def table(rows: Sequence[Mapping[str, Any]]) -> str:
     for row in rows:
         ours, woflan = row["ours"], row["woflan"]
         net = row["execution_net"]
-        if ours["timed_out"]:
-            our_time, verdict, witness, memory = f"> {ours['timeout']:g} s", "-", "-", "-"
+        if ours["timed_out"] or ours.get("error"):
+            our_time = "error" if ours.get("error") else f"> {ours['timeout']:g} s"
+            verdict, witness, memory = "-", "-", "-"
             markings = reduced = "-"
         else:
             our_time = _duration(ours["seconds"])
@@ -402,7 +409,10 @@ def table(rows: Sequence[Mapping[str, Any]]) -> str:
 def _summary(row: Mapping[str, Any]) -> str:
     """One line per net while the benchmark runs, so a slow Woflan shows where it is."""
     ours, woflan = row["ours"], row["woflan"]
-    text = f"ours {'timed out' if ours['timed_out'] else _duration(ours['seconds'])}"
+    if ours.get("error"):
+        text = f"ours failed: {ours['error']}"
+    else:
+        text = f"ours {'timed out' if ours['timed_out'] else _duration(ours['seconds'])}"
     if woflan is not None:
         if woflan["timed_out"]:
             text += f", woflan > {woflan['timeout']:g} s" + (
@@ -524,7 +534,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"\n{len(result['nets'])} nets in {result['seconds']:.0f} s; "
         f"{len(flagged)} flagged; results in {settings.results_dir / 'soundness-latest.json'}"
     )
-    return 0
+    # Slow nets and disagreements are findings for the reader; a crash of our check is a bug.
+    return 1 if any("ENGINE-ERROR" in row["flags"] for row in result["nets"]) else 0
 
 
 if __name__ == "__main__":
