@@ -2,7 +2,7 @@
 
 An outsider (an engineer elsewhere) gets 404 for each of our objects and never
 sees them in a list; an operator reads but gets 403 on every write; a request
-without credentials gets 401 or 403; members get through (the positive control
+without credentials gets 401; members get through (the positive control
 that shows the 404s are the wall, not a broken URL).
 """
 
@@ -163,7 +163,10 @@ def test_an_operator_lists_their_organisations_objects(
 def test_without_credentials_every_endpoint_is_refused(
     anonymous_client: APIClient, world: World, endpoint: Endpoint
 ) -> None:
-    assert endpoint.call(anonymous_client, world.ids).status_code in (401, 403)
+    response = endpoint.call(anonymous_client, world.ids)
+
+    assert response.status_code == 401
+    assert response["WWW-Authenticate"] == "Token"
     world.assert_untouched()
 
 
