@@ -21,12 +21,36 @@ def test_an_integrator_authenticates_with_a_token(engineer: User, pattern: Patte
     assert response.data["count"] == 1
 
 
+def test_an_integrator_trades_credentials_for_a_token_once(engineer: User) -> None:
+    client = APIClient()
+
+    response = client.post(
+        "/api/token/",
+        {"username": engineer.username, "password": factories.PASSWORD},
+        format="json",
+    )
+
+    assert response.status_code == 200
+    assert response.data["token"] == Token.objects.get(user=engineer).key
+
+
+def test_wrong_credentials_get_no_token_and_a_message(engineer: User) -> None:
+    response = APIClient().post(
+        "/api/token/", {"username": engineer.username, "password": "wrong"}, format="json"
+    )
+
+    assert response.status_code == 400
+    assert "Unable to log in" in str(response.data)
+    assert not Token.objects.filter(user=engineer).exists()
+
+
 def test_a_wrong_token_is_refused(db: None) -> None:
     client = APIClient()
     client.credentials(HTTP_AUTHORIZATION="Token not-a-real-token")
     response = client.get("/api/patterns/")
-    # 403, not 401: DRF takes the status from the first authentication class (session).
-    assert response.status_code in (401, 403)
+    # 401 with a challenge: token authentication comes first, so DRF answers as it would.
+    assert response.status_code == 401
+    assert response["WWW-Authenticate"] == "Token"
     assert response.data["detail"] == "Invalid token."
 
 
