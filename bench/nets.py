@@ -26,7 +26,7 @@ from typing import Any
 
 Document = dict[str, Any]
 
-FAMILIES: tuple[str, ...] = ("blocks", "wide-2", "wide-3", "lanes", "lanes-dead")
+FAMILIES: tuple[str, ...] = ("blocks", "wide-2", "wide-3", "choices-3", "lanes", "lanes-dead")
 SIZES: tuple[int, ...] = (20, 100, 200)
 
 # Tasks per branch of a `blocks` block before the remainder is spread: short
@@ -176,6 +176,36 @@ def wide(transitions: int, width: int) -> Document:
     return _document(f"wide-{width}-{transitions}", actors, builder)
 
 
+def choices(transitions: int, width: int) -> Document:
+    """One AND-split into `width` chains of exclusive choices (two alternative tasks a step).
+
+    The structural reduction cannot fold a choice away, so every chain keeps
+    one state per step and the markings multiply across chains: this family
+    measures the state-space search itself, not the reduction.
+    """
+    if transitions < 2 + 2 * width:
+        raise ValueError(f"choices-{width} needs at least {2 + 2 * width} transitions")
+    actors = _actors(width)
+    builder = _Builder()
+    start = builder.place(tokens=1)
+    split, join = builder.silent("split1"), builder.silent("join1")
+    builder.arc(start, split)
+    for actor, count in zip(actors, _spread(transitions - 2, width), strict=True):
+        place = builder.place()
+        builder.arc(split, place)
+        steps = _spread(count, (count + 1) // 2)  # 2 alternatives a step; a lone 1 if odd
+        for alternatives in steps:
+            after = builder.place()
+            for _ in range(alternatives):
+                task = builder.task(actor["id"])
+                builder.arc(place, task)
+                builder.arc(task, after)
+            place = after
+        builder.arc(place, join)
+    builder.arc(join, builder.place())
+    return _document(f"choices-{width}-{transitions}", actors, builder)
+
+
 def _lane_net(transitions: int) -> tuple[list[dict[str, str]], _Builder, list[str], list[str]]:
     """The two lanes: split → operator lane ∥ cobot lane → join; returns both lanes' tasks."""
     if transitions < 6:
@@ -242,6 +272,7 @@ GENERATORS: dict[str, Callable[[int], Document]] = {
     "wide-3": lambda transitions: wide(transitions, 3),
     "lanes": lanes,
     "lanes-dead": lanes_dead,
+    "choices-3": lambda transitions: choices(transitions, 3),
 }
 
 # Families whose every run ends properly; `lanes-dead` deadlocks by construction.
