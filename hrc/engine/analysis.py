@@ -10,7 +10,7 @@ reported, and a verdict that needs the whole space becomes "too large to
 decide" instead of a hang.
 """
 
-from collections import deque
+from collections import Counter, deque
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Literal
@@ -60,125 +60,134 @@ class Analysis:
 
 
 class _Explorer:
-    """Breadth-first exploration of a reduced net over markings as tuples of counts."""
+    """Breadth-first exploration of a reduced net.
+
+    A marking is held as the sorted tuple of its tokens' place indices (a
+    multiset): markings of workflow nets hold a handful of tokens among many
+    places, so this is smaller and faster to hash than one count per place.
+    Markings are numbered in the order they are found; edges and parents
+    refer to those numbers.
+    """
 
     def __init__(self, net: Net, reduced: ReducedNet, max_markings: int) -> None:
         self.net = net
         self.reduced = reduced
         self.max_markings = max_markings
         self.index = {place: i for i, place in enumerate(reduced.places)}
-        self.pre = [[(self.index[p], w) for p, w in t.pre] for t in reduced.transitions]
-        self.delta = [self._delta(t.pre, t.post) for t in reduced.transitions]
+        self.pre = [self._tokens(t.pre) for t in reduced.transitions]
+        self.post = [self._tokens(t.post) for t in reduced.transitions]
+        self.need = [Counter(pre) for pre in self.pre]
         # Candidates per marked place, so a marking only tests transitions it can feed.
         self.consumers: list[list[int]] = [[] for _ in reduced.places]
-        self.always = [i for i, pre in enumerate(self.pre) if not pre]
-        for i, pre in enumerate(self.pre):
+        self.always = [t for t, pre in enumerate(self.pre) if not pre]
+        for t, pre in enumerate(self.pre):
             if pre:
-                self.consumers[min(pre)[0]].append(i)
+                self.consumers[pre[0]].append(t)
         self.ignored = {self.index[p] for p in net.ignored if p in self.index}
         self.final = self._state(net.final)
         self.cyclic = _has_cycle(reduced)
-        self.parent: dict[_State, tuple[_State, int] | None] = {}
+        self.ids: dict[_State, int] = {}
         self.order: list[_State] = []
-        self.edges: dict[_State, list[tuple[int, _State]]] = {}
+        self.parent: list[tuple[int, int] | None] = []
+        self.edges: list[list[tuple[int, int]]] = []
         self.unbounded: Fault | None = None
+        self.expanded = 0
+        """How many markings, in order, had their successors computed."""
 
-    def _delta(
-        self, pre: tuple[tuple[str, int], ...], post: tuple[tuple[str, int], ...]
-    ) -> list[tuple[int, int]]:
-        change: dict[int, int] = {}
-        for place, weight in pre:
-            change[self.index[place]] = change.get(self.index[place], 0) - weight
-        for place, weight in post:
-            change[self.index[place]] = change.get(self.index[place], 0) + weight
-        return [(i, d) for i, d in change.items() if d]
+    def _tokens(self, arcs: tuple[tuple[str, int], ...]) -> tuple[int, ...]:
+        return tuple(sorted(self.index[place] for place, weight in arcs for _ in range(weight)))
 
     def _state(self, marking: Marking) -> _State:
-        tokens = [0] * len(self.index)
-        for place, count in marking.items():
-            tokens[self.index[place]] = count
-        return tuple(tokens)
+        return tuple(sorted(self.index[p] for p, n in marking.items() for _ in range(n)))
 
     def marking(self, state: _State) -> Marking:
-        return Marking((self.reduced.places[i], n) for i, n in enumerate(state) if n)
+        return Marking((self.reduced.places[i], n) for i, n in Counter(state).items())
 
     def successors(self, state: _State) -> Iterator[tuple[int, _State]]:
-        candidates = list(self.always)
-        for i, count in enumerate(state):
-            if count:
-                candidates.extend(self.consumers[i])
+        counts = Counter(state)
+        candidates = set(self.always)
+        for i in counts:
+            candidates.update(self.consumers[i])
         for t in sorted(candidates):
-            if all(state[i] >= w for i, w in self.pre[t]):
+            if all(counts[i] >= w for i, w in self.need[t].items()):
                 tokens = list(state)
-                for i, d in self.delta[t]:
-                    tokens[i] += d
+                for i in self.pre[t]:
+                    tokens.remove(i)
+                tokens.extend(self.post[t])
+                tokens.sort()
                 yield t, tuple(tokens)
+
+    def _add(self, state: _State, parent: tuple[int, int] | None) -> int:
+        number = self.ids[state] = len(self.order)
+        self.order.append(state)
+        self.parent.append(parent)
+        self.edges.append([])
+        return number
 
     def explore(self) -> bool:
         """Fills `order`, `parent` and `edges`; False when the cap stopped it early."""
-        start = self._state(self.net.initial)
-        self.parent[start] = None
-        self.order.append(start)
-        queue = deque([start])
+        queue = deque([self._add(self._state(self.net.initial), None)])
         while queue:
-            state = queue.popleft()
-            out = self.edges[state] = []
-            for t, successor in self.successors(state):
-                out.append((t, successor))
-                if successor in self.parent:
+            number = queue.popleft()
+            out = self.edges[number]
+            for t, successor in self.successors(self.order[number]):
+                known = self.ids.get(successor)
+                if known is not None:
+                    out.append((t, known))
                     continue
-                self.parent[successor] = (state, t)
-                if self.cyclic and self.unbounded is None:
-                    self.unbounded = self._covering(successor)
+                found = self._add(successor, (number, t))
+                out.append((t, found))
+                if self.cyclic:
+                    self.unbounded = self._covering(found)
                     if self.unbounded is not None:
                         return True  # An unbounded space has no end: what else it holds is moot.
-                self.order.append(successor)
                 if len(self.order) >= self.max_markings:
+                    self.expanded = number + 1
                     return False
-                queue.append(successor)
+                queue.append(found)
+        self.expanded = len(self.order)
         return True
 
-    def _covering(self, state: _State) -> Fault | None:
+    def _covering(self, number: int) -> Fault | None:
         """An ancestor this marking strictly covers proves a place unbounded (Karp–Miller)."""
-        total = sum(state)
-        link = self.parent[state]
+        state = self.order[number]
+        counts = Counter(state)
+        link = self.parent[number]
         while link is not None:
             ancestor, _ = link
-            if sum(ancestor) < total and all(a <= b for a, b in zip(ancestor, state, strict=True)):
-                grown = next(
-                    i for i, (a, b) in enumerate(zip(ancestor, state, strict=True)) if b > a
-                )
+            smaller = Counter(self.order[ancestor])
+            if len(self.order[ancestor]) < len(state) and smaller <= counts:
+                grown = next(i for i in counts if counts[i] > smaller[i])
                 prefix = self.path(ancestor)
                 return Fault(
                     "unbounded",
                     self.marking(state),
                     witness=prefix,
                     place=self.reduced.places[grown],
-                    repeat=self.path(state)[len(prefix) :],
+                    repeat=self.path(number)[len(prefix) :],
                 )
             link = self.parent[ancestor]
         return None
 
-    def path(self, state: _State) -> tuple[str, ...]:
-        """The original firings of the breadth-first (shortest) path to `state`."""
+    def path(self, number: int) -> tuple[str, ...]:
+        """The original firings of the breadth-first (shortest) path to marking `number`."""
         steps: list[int] = []
-        link = self.parent[state]
+        link = self.parent[number]
         while link is not None:
-            state, t = link
+            number, t = link
             steps.append(t)
-            link = self.parent[state]
+            link = self.parent[number]
         return tuple(f for t in reversed(steps) for f in self.reduced.transitions[t].firings)
 
     def is_final(self, state: _State) -> bool:
-        return all(
-            n == f or i in self.ignored
-            for i, (n, f) in enumerate(zip(state, self.final, strict=True))
-        )
+        return tuple(i for i in state if i not in self.ignored) == self.final
 
     def is_improper(self, state: _State) -> bool:
         """The end is marked but something else (apart from constraint places) still is too."""
-        covers = all(n >= f for n, f in zip(state, self.final, strict=True))
-        return covers and not self.is_final(state)
+        return Counter(self.final) <= Counter(state) and not self.is_final(state)
+
+    def fault(self, kind: FaultKind, number: int) -> Fault:
+        return Fault(kind, self.marking(self.order[number]), self.path(number))
 
 
 def analyse(net: Net, max_markings: int = DEFAULT_MAX_MARKINGS) -> Analysis:
@@ -204,43 +213,39 @@ def analyse(net: Net, max_markings: int = DEFAULT_MAX_MARKINGS) -> Analysis:
 
 
 def _local_faults(explorer: _Explorer) -> Iterator[Fault]:
-    """Faults a single marking shows: the first deadlock and the first improper end, in BFS order."""
-    deadlock: _State | None = None
-    improper: _State | None = None
-    for state in explorer.order:
-        if state not in explorer.edges:
-            break  # Past the cap: not expanded, so "no successor" would be a lie.
-        dead = not explorer.edges[state]
-        if (
-            deadlock is None
-            and dead
-            and not explorer.is_final(state)
-            and not explorer.is_improper(state)
-        ):
-            deadlock = state
-        if improper is None and explorer.is_improper(state):
-            improper = state
+    """Faults one marking shows: the first deadlock and the first improper end, in BFS order.
+
+    Only expanded markings count: past the cap, "no successor" would be a lie.
+    """
+    deadlock = improper = None
+    for number in range(explorer.expanded):
+        state = explorer.order[number]
+        if explorer.is_improper(state):
+            improper = number if improper is None else improper
+        elif deadlock is None and not explorer.edges[number] and not explorer.is_final(state):
+            deadlock = number
     if deadlock is not None:
-        yield Fault("deadlock", explorer.marking(deadlock), explorer.path(deadlock))
+        yield explorer.fault("deadlock", deadlock)
     if improper is not None:
-        yield Fault("improper", explorer.marking(improper), explorer.path(improper))
+        yield explorer.fault("improper", improper)
 
 
 def _global_faults(explorer: _Explorer) -> Iterator[Fault]:
     """Faults that need the whole space: no way to the end (livelock), transitions that never fire."""
-    reverse: dict[_State, list[_State]] = {state: [] for state in explorer.order}
-    for state, out in explorer.edges.items():
+    reverse: dict[int, list[int]] = {number: [] for number in range(len(explorer.order))}
+    for number, out in enumerate(explorer.edges):
         for _, successor in out:
-            reverse[successor].append(state)
-    can_finish = reachable([s for s in explorer.order if explorer.is_final(s)], reverse)
-    can_end = reachable([s for s in explorer.order if not explorer.edges[s]], reverse)
+            reverse[successor].append(number)
+    numbers = range(len(explorer.order))
+    can_finish = reachable([n for n in numbers if explorer.is_final(explorer.order[n])], reverse)
+    can_end = reachable([n for n in numbers if not explorer.edges[n]], reverse)
     # A livelock: the case runs on but can neither finish nor even get stuck.
-    looping = next((s for s in explorer.order if s not in can_finish and s not in can_end), None)
+    looping = next((n for n in numbers if n not in can_finish and n not in can_end), None)
     if looping is not None:
-        yield Fault("livelock", explorer.marking(looping), explorer.path(looping))
+        yield explorer.fault("livelock", looping)
     fired = {
         firing
-        for out in explorer.edges.values()
+        for out in explorer.edges
         for t, _ in out
         for firing in explorer.reduced.transitions[t].firings
     }
