@@ -88,7 +88,7 @@ class _Explainer:
     def __init__(self, pattern: Pattern, net: Net) -> None:
         self.pattern = pattern
         self.net = net
-        self.constraint_of = {place: ends for place, ends in constraint_places(pattern).items()}
+        self.constraint_of = constraint_places(pattern)
 
     def fault(self, fault: Fault) -> Issue:
         sequence = self.sequence(fault.witness)
@@ -161,7 +161,7 @@ class _Explainer:
             )
         message = f"{'; '.join(parts)} in any run of the model."
         needs = [
-            f"{t.label} needs {self.constraint_words(p)}"
+            f"{t.label} needs {self.constraint_of[p].needed()}"
             for t in never_start + never_complete
             for p, _ in t.pre
             if p in self.constraint_of
@@ -172,28 +172,33 @@ class _Explainer:
         return error("unsound", message[0].upper() + message[1:], *elements)
 
     def waits(self, marking: Marking) -> list[tuple[str, list[str]]]:
-        """For each transition that has some but not all of its inputs: what it waits for."""
-        waits = []
-        for transition in self.net.transitions:
-            have = [p for p, w in transition.pre if marking.get(p) >= w]
-            missing = [p for p, w in transition.pre if marking.get(p) < w]
-            ordinary = [p for p, _ in transition.pre if p not in self.constraint_of]
-            if not missing or not have or not all(p in have for p in ordinary):
-                continue
-            needs = " and ".join(self.constraint_words(p) for p in missing)
-            ends = [transition.task, *(e for p in missing for e in self.constraint_of[p][0:1])]
-            ends = [e.split(":", 1)[-1] for e in ends]
-            waits.append((f"{transition.label} waits for {needs}", ends))
-        return waits
+        """What the transitions that hold some of their inputs wait for.
 
-    def constraint_words(self, place: str) -> str:
-        kind, ends = place.split(":", 1)
-        a, b = ends.split(">", 1)
-        if kind == "time":
-            return f"a completion of {a} (time constraint {a} → {b})"
-        if kind == "func-start":
-            return f"{a} to be running (func constraint: {a} supports {b})"
-        return f"{a} to complete (func constraint: {b} supports {a})"
+        Those held up by a constraint alone come first and alone, as they are
+        the cause an engineer can act on; otherwise every partly enabled
+        transition says which places it lacks.
+        """
+        held_by_constraint, partly_enabled = [], []
+        for transition in self.net.transitions:
+            missing = [p for p, w in transition.pre if marking.get(p) < w]
+            if not missing or len(missing) == len(transition.pre):
+                continue
+            needs = " and ".join(self.needed(p) for p in missing)
+            ends = [transition.task]
+            ends += [self.constraint_of[p].first for p in missing if p in self.constraint_of]
+            wait = (f"{transition.label} waits for {needs}", ends)
+            if all(p in self.constraint_of for p in missing):
+                held_by_constraint.append(wait)
+            else:
+                partly_enabled.append(wait)
+        return held_by_constraint or partly_enabled
+
+    def needed(self, place: str) -> str:
+        if place in self.constraint_of:
+            return self.constraint_of[place].needed()
+        if place.startswith("running:"):
+            return f"{place.split(':', 1)[1]} to be running"
+        return f"a token in {place}"
 
     def place_words(self, place: str) -> str:
         if place.startswith("running:"):

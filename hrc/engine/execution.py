@@ -19,6 +19,7 @@ structural): it assumes every arc, performer and constraint end exists.
 
 from collections import defaultdict
 from dataclasses import dataclass
+from typing import Literal
 
 from hrc.engine.model import Constraint, Pattern
 from hrc.engine.petri import Marking, Net, NetTransition
@@ -46,22 +47,43 @@ def supporter_of(pattern: Pattern, constraint: Constraint) -> tuple[str, str]:
     return constraint.source, constraint.target
 
 
-def constraint_places(pattern: Pattern) -> dict[str, tuple[str, str]]:
-    """Each constraint place with (producing firing, consuming firing), e.g. `time:a>b` → (complete:a, start:b)."""
-    places: dict[str, tuple[str, str]] = {}
+@dataclass(frozen=True)
+class ConstraintPlace:
+    """A place a constraint adds, and what it means in the pattern's words."""
+
+    kind: Literal["time", "func-start", "func-done"]
+    first: str
+    """time: t_a; func-start: the supporter; func-done: the supported task."""
+    second: str
+    """time: t_b; func-start: the supported task; func-done: the supporter."""
+    producer: str
+    consumer: str
+
+    def needed(self) -> str:
+        """What the consumer waits for, as a person says it."""
+        if self.kind == "time":
+            return f"a completion of {self.first} (time constraint {self.first} → {self.second})"
+        if self.kind == "func-start":
+            return (
+                f"{self.first} to be running (func constraint: {self.first} supports {self.second})"
+            )
+        return f"{self.first} to complete (func constraint: {self.second} supports {self.first})"
+
+
+def constraint_places(pattern: Pattern) -> dict[str, ConstraintPlace]:
+    """Each constraint place by id, e.g. `time:a>b`, made by `complete:a` and taken by `start:b`."""
+    places: dict[str, ConstraintPlace] = {}
     for constraint in pattern.constraints:
         a, b = constraint.source, constraint.target
         if constraint.type == "time":
-            places[f"time:{a}>{b}"] = (f"complete:{a}", f"start:{b}")
+            places[f"time:{a}>{b}"] = ConstraintPlace("time", a, b, f"complete:{a}", f"start:{b}")
         elif constraint.type == "func":
-            supporter, supported = supporter_of(pattern, constraint)
-            places[f"func-start:{supporter}>{supported}"] = (
-                f"start:{supporter}",
-                f"start:{supported}",
+            s, d = supporter_of(pattern, constraint)
+            places[f"func-start:{s}>{d}"] = ConstraintPlace(
+                "func-start", s, d, f"start:{s}", f"start:{d}"
             )
-            places[f"func-done:{supported}>{supporter}"] = (
-                f"complete:{supported}",
-                f"complete:{supporter}",
+            places[f"func-done:{d}>{s}"] = ConstraintPlace(
+                "func-done", d, s, f"complete:{d}", f"complete:{s}"
             )
     return places
 
@@ -100,10 +122,10 @@ def build_execution_net(pattern: Pattern) -> Net:
             pre[f"complete:{t}"] = [(running, 1)]
             post[f"complete:{t}"] = list(outputs[t])
     ignored = constraint_places(pattern)
-    for place, (producer, consumer) in ignored.items():
+    for place, constraint in ignored.items():
         places.append(place)
-        post[producer].append((place, 1))
-        pre[consumer].append((place, 1))
+        post[constraint.producer].append((place, 1))
+        pre[constraint.consumer].append((place, 1))
     return Net(
         places=tuple(dict.fromkeys(places)),
         transitions=tuple(

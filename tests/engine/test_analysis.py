@@ -144,3 +144,20 @@ def test_the_reduction_keeps_every_original_firing_in_order() -> None:
     assert sorted(firings) == sorted(t.id for t in net.transitions)
     chain = next(t.firings for t in reduced.transitions if t.firings[0] == "start:tc2")
     assert chain[:2] == ("start:tc2", "complete:tc2")
+
+
+def test_a_deadlock_without_constraints_names_what_the_join_lacks() -> None:
+    # to2 skips the split: the operator's branch arrives at the join without the cobot's.
+    net = process(
+        "N",
+        "p1 t1 p2 tc1 p3 t2 p4",
+        "t1 p5 to1 p6 t2",
+        "p1 to2 p5",
+        performers={"tc1": "c", "to1": "o", "to2": "o"},
+    )
+
+    deadlock = next(e for e in check_document(document(net)).errors if "deadlock" in e.message)
+
+    assert deadlock.witness == ("start to2", "complete to2", "start to1", "complete to1")
+    assert deadlock.message.endswith("t2 waits for a token in p3")
+    assert deadlock.elements == ("t2",)
