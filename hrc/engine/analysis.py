@@ -12,7 +12,7 @@ decide" instead of a hang.
 
 from collections import Counter, deque
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 from hrc.engine.graph import reachable
@@ -48,9 +48,8 @@ class Analysis:
     decided: bool
     """False when exploration hit the cap before every fault kind could be ruled out."""
     faults: tuple[Fault, ...]
-    markings: int
-    reduced_transitions: int
-    stats: dict[str, int] = field(default_factory=dict)
+    stats: dict[str, int]
+    """Sizes of the net, of the reduced net, and `markings`: how many were explored."""
 
     @property
     def sound(self) -> bool | None:
@@ -209,7 +208,7 @@ def analyse(net: Net, max_markings: int = DEFAULT_MAX_MARKINGS) -> Analysis:
         "reduced_transitions": len(reduced.transitions),
         "markings": len(explorer.order),
     }
-    return Analysis(complete, tuple(faults), len(explorer.order), len(reduced.transitions), stats)
+    return Analysis(complete, tuple(faults), stats)
 
 
 def _local_faults(explorer: _Explorer) -> Iterator[Fault]:

@@ -74,7 +74,7 @@ def _analysis_issues(pattern: Pattern, net: Net, analysis: Analysis) -> list[Iss
         issues.append(
             warning(
                 "state-space-too-large",
-                f"The model is too large to decide: {analysis.markings} markings were explored "
+                f"The model is too large to decide: {analysis.stats['markings']} markings were explored "
                 "without finding a fault, and the check stops there. Split it into smaller "
                 "patterns or reduce the parallel branches.",
             )
@@ -86,8 +86,8 @@ class _Explainer:
     """Turns faults into messages an engineer can act on, in the pattern's words."""
 
     def __init__(self, pattern: Pattern, net: Net) -> None:
-        self.pattern = pattern
         self.net = net
+        self.transition = {t.id: t for t in net.transitions}
         self.constraint_of = constraint_places(pattern)
 
     def fault(self, fault: Fault) -> Issue:
@@ -115,9 +115,9 @@ class _Explainer:
                 f"The case can loop without end: {sequence}, it can no longer reach its end "
                 "place, though tasks can still run."
             )
-            elements = sorted({self.net.transition(f).task for f in fault.witness[-3:]})
+            elements = sorted({self.transition[f].task for f in fault.witness[-3:]})
         else:
-            repeat = ", ".join(self.net.transition(f).label for f in fault.repeat)
+            repeat = ", ".join(self.transition[f].label for f in fault.repeat)
             place = fault.place or "?"
             message = (
                 f"{self.place_words(place).capitalize()} can collect tokens without limit: "
@@ -209,7 +209,7 @@ class _Explainer:
         return place.split(":", 1)[1] if place.startswith("running:") else place
 
     def labels(self, firings: tuple[str, ...]) -> tuple[str, ...]:
-        return tuple(self.net.transition(f).label for f in firings)
+        return tuple(self.transition[f].label for f in firings)
 
     def sequence(self, firings: tuple[str, ...]) -> str:
         if not firings:

@@ -106,13 +106,6 @@ class Net:
     final: Marking
     ignored: frozenset[str] = field(default_factory=frozenset)
 
-    def transition(self, transition_id: str) -> NetTransition:
-        """The transition with this id; raises KeyError when there is none."""
-        for transition in self.transitions:
-            if transition.id == transition_id:
-                return transition
-        raise KeyError(transition_id)
-
     def enabled(self, marking: Mapping[str, int]) -> list[NetTransition]:
         """The transitions that can fire in this marking, in net order."""
         return [t for t in self.transitions if t.is_enabled(marking)]
