@@ -8,8 +8,10 @@ to no organisation.
 
 import pytest
 from django.contrib.auth.models import User
+from django.test import Client
 from rest_framework.test import APIClient
 
+from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel
@@ -92,3 +94,14 @@ def anonymous_client() -> APIClient:
 def pattern(organisation: Organisation, engineer: User) -> PatternModel:
     """A valid, sound, unpublished pattern of the home organisation."""
     return factories.make_pattern(organisation, name="Hand-over", created_by=engineer)
+
+
+@pytest.fixture
+def staff_client(db: None) -> Client:
+    """A browser signed in to the Django admin as a superuser."""
+    superuser = organisation_services.provision_user(
+        "root", password="a-test-password", is_staff=True, is_superuser=True
+    )
+    client = Client()
+    client.force_login(superuser)
+    return client

@@ -1,20 +1,8 @@
-import pytest
 from django.test import Client
 
 from hrc.cobots.models import Cobot
-from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
 from tests import factories
-
-
-@pytest.fixture
-def staff_client(db: None) -> Client:
-    superuser = organisation_services.provision_user(
-        "root", password="a-test-password", is_staff=True, is_superuser=True
-    )
-    client = Client()
-    client.force_login(superuser)
-    return client
 
 
 def test_cobot_pages_render(staff_client: Client, organisation: Organisation) -> None:

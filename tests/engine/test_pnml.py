@@ -24,6 +24,7 @@ from hrc.engine.model import (
     Transition,
 )
 from hrc.engine.pnml import PNML_NAMESPACE, PTNET_TYPE, pattern_to_pnml, pnml_to_pattern
+from tests.hostile_xml import BILLION_LAUGHS, EXTERNAL_ENTITY
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples"
 NS = {"pnml": PNML_NAMESPACE}
@@ -444,24 +445,6 @@ def test_each_foreign_net_becomes_a_process_and_dangling_arcs_are_kept() -> None
 
 
 # Bad input -------------------------------------------------------------------------------
-
-BILLION_LAUGHS = """<?xml version="1.0"?>
-<!DOCTYPE pnml [
-  <!ENTITY lol "lol">
-  <!ENTITY lol2 "&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;">
-  <!ENTITY lol3 "&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;">
-  <!ENTITY lol4 "&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;">
-  <!ENTITY lol5 "&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;">
-  <!ENTITY lol6 "&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;">
-  <!ENTITY lol7 "&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;">
-  <!ENTITY lol8 "&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;">
-  <!ENTITY lol9 "&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;">
-]>
-<pnml><net id="n"><name><text>&lol9;</text></name></net></pnml>"""
-
-EXTERNAL_ENTITY = """<?xml version="1.0"?>
-<!DOCTYPE pnml [<!ENTITY secret SYSTEM "file:///etc/passwd">]>
-<pnml><net id="n"><name><text>&secret;</text></name></net></pnml>"""
 
 
 def net(body: str, net_type: str = PTNET_TYPE) -> str:

@@ -2,19 +2,8 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
-from hrc.organisations import services
 from hrc.organisations.models import Membership, Organisation, Team
 from tests import factories
-
-
-@pytest.fixture
-def staff_client(db: None) -> Client:
-    superuser = services.provision_user(
-        "root", password="a-test-password", is_staff=True, is_superuser=True
-    )
-    client = Client()
-    client.force_login(superuser)
-    return client
 
 
 def _inline_management(prefix: str, total: int, initial: int = 0) -> dict[str, str]:

@@ -4,21 +4,10 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
-from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
 from hrc.patterns import services
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
-
-
-@pytest.fixture
-def staff_client(db: None) -> Client:
-    superuser = organisation_services.provision_user(
-        "root", password="a-test-password", is_staff=True, is_superuser=True
-    )
-    client = Client()
-    client.force_login(superuser)
-    return client
 
 
 @pytest.fixture

@@ -12,6 +12,7 @@ from hrc.organisations.models import Organisation
 from hrc.patterns import services
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
+from tests.hostile_xml import BILLION_LAUGHS, EXTERNAL_ENTITY
 
 MB = 1024 * 1024
 
@@ -480,28 +481,9 @@ def test_an_unknown_format_is_a_400_naming_the_formats(
     assert "json or pnml" in imported.data["detail"]
 
 
-BILLION_LAUGHS = b"""<?xml version="1.0"?>
-<!DOCTYPE lolz [
- <!ENTITY lol "lol">
- <!ENTITY lol2 "&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;">
- <!ENTITY lol3 "&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;">
- <!ENTITY lol4 "&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;">
- <!ENTITY lol5 "&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;&lol4;">
- <!ENTITY lol6 "&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;&lol5;">
- <!ENTITY lol7 "&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;&lol6;">
- <!ENTITY lol8 "&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;&lol7;">
- <!ENTITY lol9 "&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;&lol8;">
-]>
-<pnml><net id="n" type="http://www.pnml.org/version-2009/grammar/ptnet">
-<name><text>&lol9;</text></name></net></pnml>"""
-
-EXTERNAL_ENTITY = b"""<?xml version="1.0"?>
-<!DOCTYPE pnml [<!ENTITY secret SYSTEM "file:///etc/passwd">]>
-<pnml><net id="n" type="http://www.pnml.org/version-2009/grammar/ptnet">
-<name><text>&secret;</text></name></net></pnml>"""
-
-
-@pytest.mark.parametrize("xml", [BILLION_LAUGHS, EXTERNAL_ENTITY], ids=["bomb", "external"])
+@pytest.mark.parametrize(
+    "xml", [BILLION_LAUGHS.encode(), EXTERNAL_ENTITY.encode()], ids=["bomb", "external"]
+)
 def test_hostile_xml_is_refused(engineer_client: APIClient, xml: bytes) -> None:
     response = engineer_client.post("/api/patterns/import/", xml, content_type="application/xml")
     assert response.status_code == 400
