@@ -3,7 +3,6 @@
 from django.db.models import QuerySet
 from rest_framework import serializers, viewsets
 
-from hrc.api.parsers import LimitedJSONParser
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
 from hrc.cobots import services
 from hrc.cobots.api.serializers import CobotSerializer
@@ -16,7 +15,6 @@ class CobotViewSet(viewsets.ModelViewSet[Cobot]):
 
     serializer_class = CobotSerializer
     permission_classes = [MembersReadWritersWrite]
-    parser_classes = [LimitedJSONParser]
 
     def get_queryset(self) -> QuerySet[Cobot]:
         return cobots_visible_to(self.request.user).order_by("name", "id")

@@ -25,7 +25,7 @@ from rest_framework.response import Response
 
 from hrc.api.exceptions import Rejected
 from hrc.api.negotiation import FormatParameterForViews
-from hrc.api.parsers import LimitedJSONParser, parse_json_body, read_body
+from hrc.api.parsers import parse_json_body, read_body
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
 from hrc.patterns import services
 from hrc.patterns.api.serializers import (
@@ -76,7 +76,6 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     """Collaboration patterns of your organisations. Members read; engineers and admins write."""
 
     permission_classes = [MembersReadWritersWrite]
-    parser_classes = [LimitedJSONParser]
     content_negotiation_class = FormatParameterForViews
     # POSTs that change nothing: operators may run them too.
     read_actions = frozenset({"check"})
