@@ -6,9 +6,9 @@ from django.db import models
 class DriverKind(models.TextChoices):
     """Which driver talks to the cobot."""
 
-    # The project's own OPC UA simulator (hrc/cobots/sim/), a URUA-compatible stand-in for URSim.
+    # A gateway with the simulated backend (hrc/cobots/gateway/sim/), a stand-in for URSim + URUA.
     SIMULATED = "simulated", "Simulated (OPC UA simulator)"
-    # A Universal Robots controller: commands over OPC UA (URUA server), registers over RTDE.
+    # A Universal Robots controller behind a gateway with the ur-rtde backend (hrc/cobots/gateway/ur/).
     UR = "ur", "Universal Robots (OPC UA + RTDE)"
 
 

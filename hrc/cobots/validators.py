@@ -32,14 +32,24 @@ def validate_endpoint(value: str) -> None:
         )
 
 
-def validate_credentials_source(value: str) -> None:
-    """Accepts `none`, `env:VARIABLE` or `file:/absolute/path`: a reference, never a secret."""
+def split_credentials_source(value: str) -> tuple[CredentialsKind, str] | None:
+    """(kind, reference) of `none`, `env:VARIABLE` or `file:/absolute/path`; None for anything else.
+
+    The one reading of a source, for the model's check and the driver's lookup alike.
+    """
     kind, _, reference = value.partition(":")
     if kind == CredentialsKind.NONE and not reference:
-        return
+        return CredentialsKind.NONE, ""
     if kind == CredentialsKind.ENV and _ENV_NAME.fullmatch(reference):
-        return
+        return CredentialsKind.ENV, reference
     if kind == CredentialsKind.FILE and reference.startswith("/"):
+        return CredentialsKind.FILE, reference
+    return None
+
+
+def validate_credentials_source(value: str) -> None:
+    """Accepts `none`, `env:VARIABLE` or `file:/absolute/path`: a reference, never a secret."""
+    if split_credentials_source(value) is not None:
         return
     raise ValidationError(
         "The credentials source must be 'none', 'env:VARIABLE_NAME' or 'file:/absolute/path'; "

@@ -134,3 +134,9 @@ SPECTACULAR_SETTINGS = {
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
 }
+
+# Cobot gateways and drivers. Certificates and trust lists (hrc.cobots.pki);
+# keep this directory out of backups that leave the plant.
+HRC_PKI_DIR = Path(env_str("HRC_PKI_DIR") or VAR_DIR / "pki")
+# The simulator's controller state, so a simulated cobot survives a gateway restart.
+HRC_SIM_STATE_DIR = Path(env_str("HRC_SIM_STATE_DIR") or VAR_DIR / "cobots")
