@@ -4,12 +4,16 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from django.contrib import admin
+from django.contrib import admin, messages
+from django.core.exceptions import PermissionDenied
 from django.db.models import QuerySet
 from django.forms import BaseModelForm
-from django.http import HttpRequest
+from django.http import HttpRequest, HttpResponse, HttpResponseRedirect, JsonResponse
+from django.shortcuts import get_object_or_404
+from django.urls import URLPattern, path, reverse
+from django.views.decorators.http import require_POST
 
-from hrc.cobots import services
+from hrc.cobots import selectors, services
 from hrc.cobots.models import Cobot
 
 # Generic for mypy only: Django's runtime class is not subscriptable.
@@ -31,6 +35,47 @@ class CobotAdmin(CobotAdminBase):
         ("Connection", {"fields": ["driver", "endpoint", "credentials_source"]}),
         ("History", {"fields": ["created_at", "updated_at"]}),
     ]
+
+    # The change page shows the live state and a "Test connection" button.
+    change_form_template = "admin/cobots/cobot/change_form.html"
+
+    def get_urls(self) -> list[URLPattern]:
+        own = [
+            path(
+                "<int:pk>/state/",
+                self.admin_site.admin_view(self.state_view),
+                name="cobots_cobot_state",
+            ),
+            path(
+                "<int:pk>/test-connection/",
+                self.admin_site.admin_view(require_POST(self.test_connection_view)),
+                name="cobots_cobot_test_connection",
+            ),
+        ]
+        return own + super().get_urls()
+
+    def state_view(self, request: HttpRequest, pk: int) -> HttpResponse:
+        """The cobot's live state as JSON, polled by the change page."""
+        cobot = self._cobot(request, pk)
+        return JsonResponse(selectors.live_state(cobot))
+
+    def test_connection_view(self, request: HttpRequest, pk: int) -> HttpResponse:
+        cobot = self._cobot(request, pk)
+        state = selectors.live_state(cobot)
+        if state["reachable"]:
+            summary = ", ".join(f"{k}: {v}" for k, v in state.items() if k != "reachable")
+            self.message_user(request, f"{cobot.name} answered. {summary}", messages.SUCCESS)
+        else:
+            self.message_user(
+                request, f"{cobot.name} did not answer: {state['error']}", messages.ERROR
+            )
+        return HttpResponseRedirect(reverse("admin:cobots_cobot_change", args=[cobot.pk]))
+
+    def _cobot(self, request: HttpRequest, pk: int) -> Cobot:
+        cobot = get_object_or_404(self.get_queryset(request), pk=pk)
+        if not self.has_view_permission(request, cobot):
+            raise PermissionDenied
+        return cobot
 
     def get_readonly_fields(self, request: HttpRequest, obj: Cobot | None = None) -> list[str]:
         # A cobot stays in the organisation it was registered in.

@@ -1,5 +1,7 @@
 """Reads of cobots across the organisation wall."""
 
+from typing import Any
+
 from django.db.models import QuerySet
 
 from hrc.cobots.models import Cobot
@@ -11,3 +13,21 @@ def cobots_visible_to(user: AnyUser) -> QuerySet[Cobot]:
     return Cobot.objects.filter(organisation__in=organisations_of(user)).select_related(
         "organisation"
     )
+
+
+def live_state(cobot: Cobot, *, timeout: float = 3.0) -> dict[str, Any]:
+    """What the cobot reports right now, asked through the process's driver.
+
+    Returns {"reachable": True, "RobotMode": ..., "SafetyMode": ..., ...} or
+    {"reachable": False, "error": "<what went wrong>", "transient": bool};
+    never raises for a cobot that cannot be reached.
+    """
+    # Imported here: the driver pulls in asyncua, which pages that never ask don't need.
+    from hrc.cobots.drivers.base import DriverError
+    from hrc.cobots.drivers.runner import driver_for_cobot
+
+    try:
+        driver = driver_for_cobot(cobot, connect_timeout=timeout, request_timeout=timeout)
+        return {"reachable": True, **driver.state()}
+    except DriverError as error:
+        return {"reachable": False, "error": str(error), "transient": error.transient}

@@ -1,5 +1,6 @@
 from django.test import Client
 
+from hrc.cobots.gateway.launcher import GatewayProcess, free_port
 from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 from tests import factories
@@ -49,3 +50,36 @@ def test_the_admin_refuses_a_secret_as_credentials_source(
     response = staff_client.post("/admin/cobots/cobot/add/", data)
     assert response.status_code == 200
     assert not Cobot.objects.exists()
+
+
+def test_the_change_page_tests_the_connection_and_shows_live_state(
+    staff_client: Client, organisation: Organisation, gateway: GatewayProcess
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot1", endpoint=gateway.endpoint)
+    page = staff_client.get(f"/admin/cobots/cobot/{cobot.pk}/change/").content.decode()
+    assert "Live state" in page
+    assert "Test connection" in page
+    state = staff_client.get(f"/admin/cobots/cobot/{cobot.pk}/state/").json()
+    assert state["reachable"] is True
+    assert state["RobotMode"] == "Power Off"
+    response = staff_client.post(f"/admin/cobots/cobot/{cobot.pk}/test-connection/", follow=True)
+    page = response.content.decode()
+    assert "answered. RobotMode: Power Off" in page
+
+
+def test_the_connection_test_says_why_a_cobot_does_not_answer(
+    staff_client: Client, organisation: Organisation
+) -> None:
+    cobot = factories.make_cobot(organisation, endpoint=f"opc.tcp://127.0.0.1:{free_port()}")
+    state = staff_client.get(f"/admin/cobots/cobot/{cobot.pk}/state/").json()
+    assert state["reachable"] is False
+    assert "cannot reach the gateway" in state["error"]
+    response = staff_client.post(f"/admin/cobots/cobot/{cobot.pk}/test-connection/", follow=True)
+    assert "did not answer" in response.content.decode()
+
+
+def test_the_live_state_is_for_staff_only(client: Client, organisation: Organisation) -> None:
+    cobot = factories.make_cobot(organisation)
+    response = client.get(f"/admin/cobots/cobot/{cobot.pk}/state/")
+    assert response.status_code == 302
+    assert "/admin/login/" in response["Location"]

@@ -46,7 +46,7 @@ DEMO_USERS = (
     DemoUser("engineer", Role.ENGINEER),
     DemoUser("operator", Role.OPERATOR),
 )
-# The simulator serves one OPC UA endpoint per cobot (hrc/cobots/sim/).
+# `make demo` starts a simulated gateway per cobot on these ports (hrc/cobots/gateway/).
 DEMO_COBOTS = (
     ("cobot1", "opc.tcp://127.0.0.1:4841"),
     ("cobot2", "opc.tcp://127.0.0.1:4842"),
