@@ -19,10 +19,15 @@ $(STAMP): requirements/lock.txt
 
 install: $(STAMP)  ## create .venv and install the locked dependencies (idempotent)
 
-demo: install  ## load the example library into a demo organisation and serve on 127.0.0.1:8000
+demo: install  ## load the example library, start two simulated cobots, serve on 127.0.0.1:8000
 	@mkdir -p var  # the embedded SQLite database lives here when DATABASE_URL is unset
 	$(PY) manage.py migrate --noinput
 	$(PY) manage.py load_demo
+	@# The demo's cobots: simulated gateways on loopback (insecure is allowed only there),
+	@# stopped with the server.
+	$(PY) manage.py cobot_gateway --name cobot1 --port 4841 --insecure > var/cobot1.log 2>&1 & \
+	$(PY) manage.py cobot_gateway --name cobot2 --port 4842 --insecure > var/cobot2.log 2>&1 & \
+	trap 'kill %1 %2 2>/dev/null' EXIT; \
 	$(PY) manage.py runserver 127.0.0.1:8000
 
 test: install  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1)
@@ -31,14 +36,15 @@ test: install  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1)
 lint: install  ## ruff and mypy
 	.venv/bin/ruff check .
 	.venv/bin/ruff format --check .
-	.venv/bin/mypy hrc tests
+	.venv/bin/mypy hrc tests bench
 
 $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
 	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
 	@touch $@
 
-bench: $(BENCH_STAMP)  ## time the soundness check against pm4py's Woflan; JSON in bench/results/
+bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC UA; JSON in bench/results/
 	$(PY) -m bench.run
+	$(PY) -m bench.handshake
 
 lock:  ## re-resolve requirements/*.in into the lock files
 	python3 -m venv /tmp/hrc-lock && /tmp/hrc-lock/bin/pip -q install uv
