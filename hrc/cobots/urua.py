@@ -119,6 +119,8 @@ STATE_SAFETY_MODE: Final = "State/SafetyMode"
 STATE_PROGRAM_STATE: Final = "State/ProgramState"
 STATE_CURRENT_PROGRAM: Final = "State/CurrentProgram"
 STATE_LAST_ERROR: Final = "State/LastError"
+# The speed slider in percent; writable, which is how a cobot is slowed rather than paused.
+STATE_OVERRIDE: Final = "State/Override"
 # Not in URUA: a counter the gateway bumps every HEARTBEAT_SECONDS, so a
 # subscriber hears from a live gateway even when nothing else changes (and
 # asyncua's client does not take a quiet subscription for a dead one).

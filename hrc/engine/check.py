@@ -15,6 +15,7 @@ from hrc.engine.issues import Issue, error, warning
 from hrc.engine.model import Pattern
 from hrc.engine.petri import Marking, Net, NetTransition
 from hrc.engine.rules import STRUCTURAL_CODES, check_rules
+from hrc.engine.taskconfig import config_issues
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,7 @@ def check_pattern(pattern: Pattern, max_markings: int = DEFAULT_MAX_MARKINGS) ->
     issues = check_rules(pattern)
     classification = classify(pattern)
     issues += classification_issues(pattern, classification)
+    issues += config_issues(pattern)
     sound: bool | None = None
     stats: dict[str, int] = {}
     if not any(issue.code in STRUCTURAL_CODES for issue in issues):

@@ -21,7 +21,8 @@ STRUCTURAL_CODES = (
     "constraint-type",
     "not-workflow-net",
 )
-ERROR_CODES = (*STRUCTURAL_CODES, "pattern-mismatch", "unsound", "unbounded")
+# task-config: a task, guard or message configuration the runtime could not run (taskconfig.py).
+ERROR_CODES = (*STRUCTURAL_CODES, "task-config", "pattern-mismatch", "unsound", "unbounded")
 WARNING_CODES = ("vacuous-pattern", "no-pattern", "state-space-too-large")
 CODES = (*ERROR_CODES, *WARNING_CODES)
 

@@ -77,6 +77,15 @@ class PatternVersion(models.Model):
         help_text="Who published this version.",
     )
     published_at = models.DateTimeField(auto_now_add=True, help_text="When it was published.")
+    default_actor_mapping = models.JSONField(
+        default=dict,
+        blank=True,
+        help_text=(
+            "Who performs each actor unless a case says otherwise: {actor: {users: [...]} | "
+            "{team: ...} | {cobot: ...}}. The one setting of a version that may change "
+            "(services.set_default_actor_mapping); the document and report never do."
+        ),
+    )
 
     class Meta:
         ordering = ["pattern", "-number"]

@@ -34,6 +34,7 @@ INSTALLED_APPS = [
     "hrc.organisations",
     "hrc.patterns",
     "hrc.cobots",
+    "hrc.cases",
 ]
 
 MIDDLEWARE = [
@@ -92,6 +93,16 @@ else:
     CELERY_TASK_ALWAYS_EAGER = True
 CELERY_TASK_ACKS_LATE = True
 CELERY_WORKER_PREFETCH_MULTIPLIER = 1
+# A request must not hang on a broker that is down: the row is the truth and
+# the sweeper re-sends what was lost, so give up on a send quickly.
+CELERY_TASK_PUBLISH_RETRY_POLICY = {
+    "max_retries": 2,
+    "interval_start": 0,
+    "interval_step": 0.2,
+    "interval_max": 0.5,
+}
+CELERY_BROKER_CONNECTION_RETRY_ON_STARTUP = True
+CELERY_WORKER_HIJACK_ROOT_LOGGER = False
 
 AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.UserAttributeSimilarityValidator"},
@@ -140,3 +151,20 @@ SPECTACULAR_SETTINGS = {
 HRC_PKI_DIR = Path(env_str("HRC_PKI_DIR") or VAR_DIR / "pki")
 # The simulator's controller state, so a simulated cobot survives a gateway restart.
 HRC_SIM_STATE_DIR = Path(env_str("HRC_SIM_STATE_DIR") or VAR_DIR / "cobots")
+
+# Running cases (hrc.cases.jobs). Seconds unless named otherwise.
+# The sweeper finds expired leases and jobs whose message the broker lost.
+HRC_SWEEP_SECONDS = float(env_str("HRC_SWEEP_SECONDS") or 2.0)
+# A leased job's lock lasts its timeout plus this; then the sweeper takes it back.
+HRC_JOB_LEASE_MARGIN = float(env_str("HRC_JOB_LEASE_MARGIN") or 30.0)
+# The first automatic retry waits this long, each next one twice as long.
+HRC_RETRY_BACKOFF = float(env_str("HRC_RETRY_BACKOFF") or 1.0)
+# How far down a cobot's queue a free cobot looks for a job whose task may start.
+HRC_QUEUE_LOOKAHEAD = 20
+# Without a broker (the embedded demo), jobs run on a thread pool in the web process.
+HRC_INLINE_TASKS = not REDIS_URL
+
+CELERY_BEAT_SCHEDULE = {
+    "sweep-jobs": {"task": "hrc.cases.tasks.sweep", "schedule": HRC_SWEEP_SECONDS},
+    "purge-messages": {"task": "hrc.cases.tasks.purge_messages", "schedule": 600.0},
+}

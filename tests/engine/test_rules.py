@@ -85,6 +85,11 @@ def _declared_wrongly(data: Doc) -> None:
     data["declared_pattern"] = "cooperation"
 
 
+def _bad_task_config(data: Doc) -> None:
+    task = next(t for t in _net(data)["transitions"] if t["id"] == "tc1")
+    task["task"] = {"step": {"number": "=data.step +"}}
+
+
 def _deadlock(data: Doc) -> None:
     data["constraints"].append({"from": "tc3", "to": "to1", "type": "time"})
 
@@ -120,6 +125,7 @@ CASES: list[tuple[str, Callable[[Doc], None], str, set[str]]] = [
     ("process with two sink places", _two_sinks, "not-workflow-net", {"p9", "p10"}),
     ("node on no path from source to sink", _stray_cycle, "not-workflow-net", {"p10", "t3"}),
     ("declared pattern does not hold", _declared_wrongly, "pattern-mismatch", set()),
+    ("a task configuration that cannot run", _bad_task_config, "task-config", {"tc1"}),
     ("time constraints against each other", _deadlock, "unsound", {"tc2", "to1"}),
     ("a loop that adds a token each round", _unbounded, "unbounded", set()),
 ]

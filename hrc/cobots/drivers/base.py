@@ -143,5 +143,5 @@ class CobotDriver(abc.ABC):
         """The cobot's state: robot mode, safety mode, program state, program, last error."""
 
     @abc.abstractmethod
-    async def call(self, method: str, *arguments: Any, timeout: float | None = None) -> None:
-        """Calls a URUA method (PowerOn, SelectProgram, StartProgram, ...) by its path."""
+    async def call(self, method: str, *arguments: Any, timeout: float | None = None) -> list[Any]:
+        """Calls a URUA method (PowerOn, SelectProgram, StartProgram, ...) by its path; returns its outputs."""

@@ -73,9 +73,9 @@ class SyncDriver:
         limit = timeout or self.driver.step_timeout
         return _LOOP.run(self.driver.run_step(command, timeout=limit), limit)
 
-    def call(self, method: str, *arguments: Any, timeout: float | None = None) -> None:
+    def call(self, method: str, *arguments: Any, timeout: float | None = None) -> list[Any]:
         limit = timeout or self.driver.step_timeout
-        _LOOP.run(self.driver.call(method, *arguments, timeout=limit), limit)
+        return _LOOP.run(self.driver.call(method, *arguments, timeout=limit), limit)
 
     def state(self) -> dict[str, Any]:
         return _LOOP.run(self.driver.state(), self.driver.connect_timeout)

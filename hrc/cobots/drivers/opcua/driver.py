@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from asyncua import Client, Node, ua
+from asyncua.common.methods import call_method_full
 
 from hrc.cobots import urua
 from hrc.cobots.drivers.base import (
@@ -564,8 +565,11 @@ class OpcUaDriver(CobotDriver):
             path, status = bad[0]
             raise await self._refused(f"Writing {path}", status.name, path, "Write")
 
-    async def call(self, method: str, *arguments: Any, timeout: float | None = None) -> None:
-        """Calls the URUA method at `method` ("PowerOn", "Programs/x/StartProgram", ...)."""
+    async def call(self, method: str, *arguments: Any, timeout: float | None = None) -> list[Any]:
+        """Calls the URUA method at `method` ("PowerOn", "Programs/x/StartProgram", ...).
+
+        Returns its output arguments as a list (empty when it has none).
+        """
         await self._ensure_session(self._deadline(self.connect_timeout))
         assert self._client is not None
         parent_path = method.rpartition("/")[0]
@@ -575,8 +579,8 @@ class OpcUaDriver(CobotDriver):
         method_id = ua.NodeId.from_string(urua.node_id(self.name, method))
         self._cache_behind = True
         try:
-            await asyncio.wait_for(
-                parent.call_method(method_id, *arguments), timeout or self.step_timeout
+            result = await asyncio.wait_for(
+                call_method_full(parent, method_id, *arguments), timeout or self.step_timeout
             )
         except ua.UaStatusCodeError as error:
             raise await self._refused(method, _status_name(error), method, method) from None
@@ -584,6 +588,7 @@ class OpcUaDriver(CobotDriver):
             raise StepTimeout(f"{self.name}: {method} did not return in time.") from None
         except _CONNECTION_ERRORS as error:
             raise self._unreachable(error) from None
+        return list(result.OutputArguments)
 
     async def _refused(self, what: str, status: str, path: str, source: str) -> DriverError:
         """The error for a bad status, with the gateway's own explanation when it gave one.

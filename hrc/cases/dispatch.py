@@ -1,0 +1,80 @@
+"""The one way case services hand work to the background: after the transaction commits.
+
+The broker is a doorbell, never the truth: a message lost here (Redis
+restarting) costs only latency, because the sweeper (jobs.sweep) finds every
+job that is due from the rows themselves. So a failed send is logged, not raised.
+
+`run_inline` swaps Celery for a thread pool in this process (run_pattern
+without workers, and the embedded demo); everything else stays the same.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import threading
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor, ThreadPoolExecutor
+from contextlib import contextmanager
+from typing import Any
+
+from django.conf import settings
+from django.db import close_old_connections, transaction
+
+logger = logging.getLogger(__name__)
+
+_inline: Executor | None = None
+
+
+def send_on_commit(task_name: str, *args: Any, countdown: float = 0) -> None:
+    """Sends the Celery task `hrc.cases.tasks.<task_name>`(*args) once the transaction commits."""
+    transaction.on_commit(lambda: _send(task_name, args, countdown))
+
+
+def _send(task_name: str, args: tuple[Any, ...], countdown: float) -> None:
+    from hrc.cases import tasks  # the tasks module imports the services that import this one
+
+    task = getattr(tasks, task_name)
+    executor = _inline or (_embedded_pool() if settings.HRC_INLINE_TASKS else None)
+    if executor is not None:
+        _submit_inline(executor, task.run, args, countdown)
+        return
+    try:
+        task.apply_async(args, countdown=countdown or None)
+    except Exception as error:  # the broker is down: the sweeper will find the row
+        logger.warning("Could not send %s%s (%s); the sweeper will", task_name, args, error)
+
+
+def _submit_inline(
+    executor: Executor, run: Callable[..., Any], args: tuple[Any, ...], countdown: float
+) -> None:
+    def call() -> None:
+        try:
+            run(*args)
+        except Exception:
+            logger.exception("Inline task failed")
+        finally:
+            close_old_connections()
+
+    if countdown:
+        timer = threading.Timer(countdown, lambda: executor.submit(call))
+        timer.daemon = True
+        timer.start()
+    else:
+        executor.submit(call)
+
+
+@functools.cache
+def _embedded_pool() -> Executor:
+    return ThreadPoolExecutor(max_workers=4, thread_name_prefix="hrc-jobs")
+
+
+@contextmanager
+def run_inline(executor: Executor) -> Iterator[None]:
+    """Runs tasks sent inside this block on `executor` instead of Celery workers."""
+    global _inline
+    previous, _inline = _inline, executor
+    try:
+        yield
+    finally:
+        _inline = previous

@@ -1,0 +1,23 @@
+"""What case services refuse, each with the HTTP status the API answers."""
+
+
+class CaseError(Exception):
+    status = 400
+
+
+class Invalid(CaseError):
+    """The input is wrong (400); the message names what."""
+
+    status = 400
+
+
+class NotAllowed(CaseError):
+    """Not this user's to do (403)."""
+
+    status = 403
+
+
+class Conflict(CaseError):
+    """The case or work item has moved on (409): completed by someone else, ended, withdrawn."""
+
+    status = 409

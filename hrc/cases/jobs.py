@@ -1,0 +1,426 @@
+"""Running jobs on cobots: the worker's side of a case. Called by the thin Celery tasks.
+
+One cobot runs one job at a time. `run_next_job` takes the cobot's row lock,
+and only when no job of that cobot is running does it lease the first
+queued job that may start (first come, first served; a job whose case is
+suspended, whose task waits for a constraint, or whose cobot is paused for
+an operator in a shared area waits and says why). The lease is the lock: a
+worker that lost it (killed, too slow) may change nothing afterwards.
+
+Exactly once: a step carries the fencing token (job id, attempt) and the
+driver checks the cobot's registers before sending, so automatic retries and
+re-leased jobs keep the token and never move the robot twice. A device call
+has no token: one that may have gone out unanswered is never repeated by
+itself; it becomes an incident.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+from django.conf import settings
+from django.db import transaction
+from django.db.models import Q
+from django.utils import timezone
+
+from hrc.cases import dispatch, services
+from hrc.cases.choices import (
+    CaseStatus,
+    EventType,
+    IncidentKind,
+    JobState,
+    WorkItemKind,
+    WorkItemState,
+)
+from hrc.cases.models import Case, Interruption, Job, WorkItem
+from hrc.cases.nets import case_net
+from hrc.cobots import urua
+from hrc.cobots.drivers.base import (
+    CobotNotReady,
+    CommandRefused,
+    DriverError,
+    Fence,
+    StepCommand,
+)
+from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
+from hrc.cobots.models import Cobot
+from hrc.engine.petri import Marking
+
+logger = logging.getLogger(__name__)
+
+# Lease expiries of one job after which a person decides (a job that kills its worker).
+MAX_LEASE_EXPIRIES = 3
+SLOW_OVERRIDE_PERCENT = 10.0
+FULL_OVERRIDE_PERCENT = 100.0
+
+
+@dataclass(frozen=True)
+class Lease:
+    """What a worker needs to drive one job, read while it held the locks."""
+
+    job_id: int
+    lease: int
+    attempt: int
+    kind: str
+    command: dict[str, Any]
+    timeout: float
+    cobot: Cobot
+    sent_before: bool
+
+
+def run_next_job(job_id: int) -> None:
+    """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
+    cobot_id = Job.objects.filter(pk=job_id).values_list("cobot_id", flat=True).first()
+    if cobot_id is None:
+        return
+    lease = lease_next_job(cobot_id)
+    if lease is None:
+        return
+    try:
+        result = _execute(lease)
+    except DriverError as error:
+        fail_job(lease, error)
+    else:
+        finish_job(lease, result)
+
+
+def lease_next_job(cobot_id: int) -> Lease | None:
+    """Leases the cobot's first queued job that may start now; None when none may.
+
+    Starting the job's task (its `start` firing) happens here, in the same
+    transaction: the cobot taking the job is the moment the task starts.
+    """
+    now = timezone.now()
+    with transaction.atomic():
+        cobot = Cobot.objects.select_for_update().get(pk=cobot_id)
+        if Job.objects.filter(cobot=cobot, state=JobState.RUNNING).exists():
+            return None
+        if _unsettled_interruptions(cobot).exists():
+            return None
+        queued = Job.objects.filter(
+            cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
+            case__status=CaseStatus.RUNNING,
+        ).values_list("pk", "case_id")[: settings.HRC_QUEUE_LOOKAHEAD]  # fmt: skip
+        for job_id, case_id in list(queued):
+            lease = _lease_if_ready(cobot, job_id, case_id, now)
+            if lease is not None:
+                return lease
+    return None
+
+
+def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -> Lease | None:
+    case = Case.objects.select_for_update().select_related("version").get(pk=case_id)
+    job = Job.objects.select_for_update().select_related("work_item").get(pk=job_id)
+    if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
+        return None
+    item = job.work_item
+    net = case_net(case.version)
+    waiting = _why_waiting(case, item)
+    if not waiting and item.state == WorkItemState.OFFERED:
+        waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
+    if waiting:
+        if job.waiting_for != waiting:
+            job.waiting_for = waiting
+            job.save(update_fields=["waiting_for"])
+        return None
+    if item.state == WorkItemState.OFFERED:
+        services.start_cobot_task(case, net, item)
+    job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
+    job.started_at = job.started_at or now
+    job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
+    job.save()
+    case.save()
+    return Lease(
+        job.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
+        sent_before=job.sent_at is not None,
+    )  # fmt: skip
+
+
+def _why_waiting(case: Case, item: WorkItem) -> str:
+    """Why a cobot task must not start now although the marking allows it; "" when it may."""
+    net = case_net(case.version)
+    for pair in net.space_pairs:
+        if pair.cobot_task != item.task:
+            continue
+        operator = WorkItem.objects.filter(
+            case=case, task=pair.operator_task, state=WorkItemState.RUNNING
+        ).first()
+        if operator is not None:
+            return f"an operator is in the shared area ({operator.label}; space constraint)"
+    return ""
+
+
+def _unsettled_interruptions(cobot: Cobot) -> Any:
+    return Interruption.objects.filter(cobot=cobot).filter(
+        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
+    )
+
+
+def _execute(lease: Lease) -> dict[str, Any]:
+    driver = driver_for_cobot(lease.cobot, step_timeout=lease.timeout)
+    command = lease.command
+    if lease.kind == WorkItemKind.DEVICE:
+        return _call_device(driver, lease)
+    _prepare(driver, command["program"], lease.timeout)
+    step = StepCommand(
+        step=command["number"], fence=Fence(lease.job_id, lease.attempt),
+        workspace=command["workspace"], poses=command["poses"],
+    )  # fmt: skip
+    result = driver.run_step(step, timeout=lease.timeout)
+    if result.outcome not in ("ran", "duplicate"):
+        raise CommandRefused(
+            f"{lease.cobot.name}'s program answered step {step.step} of {command['program']} "
+            f"with {result.outcome!r}."
+        )
+    return {"outcome": result.outcome, "seconds": round(result.seconds, 3)}
+
+
+def _prepare(driver: SyncDriver, program: str, timeout: float) -> None:
+    """Loads and plays the step's program when the cobot is idle in another one.
+
+    Never powers the arm on and never clears a stop: a cobot that is not
+    running (powered, brakes released) is an incident for a person.
+    """
+    state = driver.state()
+    loaded = str(state.get("CurrentProgram") or "")
+    if (
+        urua.program_base_name(loaded) == program
+        and state.get("ProgramState") == urua.PROGRAM_PLAYING
+    ):
+        return
+    if state.get("RobotMode") != urua.ROBOT_MODE_RUNNING:
+        raise CobotNotReady(
+            f"{driver.name} is in robot mode {state.get('RobotMode')!r}: power it on and release "
+            "the brakes at the cell; hrc does not do that by itself.",
+            state=state,
+        )
+    if urua.program_base_name(loaded) != program:
+        driver.call("SelectProgram", program, timeout=timeout)
+    driver.call("StartProgram", timeout=timeout)
+
+
+def _call_device(driver: SyncDriver, lease: Lease) -> dict[str, Any]:
+    command = lease.command
+    if lease.sent_before:
+        raise CommandRefused(
+            f"{command['method']} went to {lease.cobot.name} before and its answer was lost; "
+            "it is not sent again by itself. Check the device, then retry or skip."
+        )
+    if not _mark_sent(lease):
+        raise CommandRefused("The job was taken over by another worker before it was sent.")
+    values = driver.call(command["method"], *command["args"], timeout=lease.timeout)
+    return dict(zip(command["outputs"], values, strict=False))
+
+
+def _mark_sent(lease: Lease) -> bool:
+    return bool(
+        Job.objects.filter(pk=lease.job_id, lease=lease.lease, state=JobState.RUNNING).update(
+            sent_at=timezone.now()
+        )
+    )
+
+
+def finish_job(lease: Lease, result: dict[str, Any]) -> None:
+    """Records a job's success and completes its task (now, or once func constraints allow)."""
+    with transaction.atomic():
+        case, job = _locked_job(lease)
+        if job is None:
+            return
+        job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
+        job.save(update_fields=["state", "result", "ended_at"])
+        if case.status in (CaseStatus.RUNNING, CaseStatus.SUSPENDED):
+            services.advance(case, case_net(case.version))
+        case.save()
+        dispatch.send_on_commit("run_job", job.pk)
+
+
+def fail_job(lease: Lease, error: DriverError) -> None:
+    """Retries a transient failure with back-off (same token); anything else becomes an incident."""
+    with transaction.atomic():
+        case, job = _locked_job(lease)
+        if job is None:
+            return
+        job.last_error = str(error)
+        item = job.work_item
+        if error.transient and job.retries_left > 0:
+            job.retries_left -= 1
+            delay = _backoff(case_net(case.version).tasks[item.task].retries - job.retries_left)
+            job.state, job.next_try_at = (
+                JobState.QUEUED,
+                timezone.now() + dt.timedelta(seconds=delay),
+            )
+            job.save()
+            services.record_event(
+                case, EventType.STEP_RETRY, item=item,
+                detail={"error": str(error), "in_seconds": delay, "retries_left": job.retries_left},
+            )  # fmt: skip
+            dispatch.send_on_commit("run_job", job.pk, countdown=delay)
+        else:
+            job.state, job.ended_at = JobState.FAILED, timezone.now()
+            job.save()
+            kind = (
+                IncidentKind.DEVICE_FAILED
+                if job.kind == WorkItemKind.DEVICE
+                else IncidentKind.STEP_FAILED
+            )
+            services.open_incident(case, kind, str(error), item=item, cobot_state=error.state)
+            dispatch.send_on_commit("run_job", job.pk)  # the cobot's next job may go
+        case.save()
+
+
+def _backoff(retries_used: int) -> float:
+    """Seconds before the next try: HRC_RETRY_BACKOFF, doubling per retry, at most a minute."""
+    return float(min(settings.HRC_RETRY_BACKOFF * 2 ** min(max(retries_used - 1, 0), 10), 60.0))
+
+
+def _locked_job(lease: Lease) -> tuple[Case, Job | None]:
+    """The case (locked) and the job, or None when this worker's lease is no longer the job's."""
+    case_id = Job.objects.values_list("case_id", flat=True).get(pk=lease.job_id)
+    case = Case.objects.select_for_update().select_related("version").get(pk=case_id)
+    job = Job.objects.select_for_update().select_related("work_item").get(pk=lease.job_id)
+    if job.state != JobState.RUNNING or job.lease != lease.lease:
+        logger.info("Job %s: lease %s was lost; its outcome is dropped", job.pk, lease.lease)
+        return case, None
+    return case, job
+
+
+# The sweeper ------------------------------------------------------------------------
+
+
+def sweep() -> dict[str, int]:
+    """Finds what the broker lost: expired leases and due jobs. Run every few seconds (beat).
+
+    An expired lease is counted; the job is queued again with its token, or,
+    after MAX_LEASE_EXPIRIES, becomes an incident. Then every cobot with a
+    due job and nothing running gets its doorbell rung.
+    """
+    now = timezone.now()
+    expired = list(
+        Job.objects.filter(state=JobState.RUNNING, lease_expires_at__lt=now).values_list(
+            "pk", "case_id"
+        )
+    )
+    for job_id, case_id in expired:
+        _expire_lease(job_id, case_id)
+    due = _first_due_per_cobot(now)
+    with transaction.atomic():  # send_on_commit needs a transaction to wait for
+        for job_id in due:
+            dispatch.send_on_commit("run_job", job_id)
+        unsettled = _interruptions_to_redo()
+        for task_name, interruption_id in unsettled:
+            dispatch.send_on_commit(task_name, interruption_id)
+    return {"expired": len(expired), "rung": len(due), "interruptions": len(unsettled)}
+
+
+def _interruptions_to_redo() -> list[tuple[str, int]]:
+    """Pauses that failed while the interruption is open, resumes not yet done after it ended."""
+    pauses = Interruption.objects.filter(ended_at__isnull=True, paused_at__isnull=True).exclude(
+        error=""
+    )
+    resumes = Interruption.objects.filter(ended_at__isnull=False, resumed_at__isnull=True)
+    return [("interrupt_cobot", pk) for pk in pauses.values_list("pk", flat=True)] + [
+        ("resume_cobot", pk) for pk in resumes.values_list("pk", flat=True)
+    ]
+
+
+def _first_due_per_cobot(now: dt.datetime) -> list[int]:
+    """The first due job of each cobot that has nothing running."""
+    busy = set(Job.objects.filter(state=JobState.RUNNING).values_list("cobot_id", flat=True))
+    firsts: dict[int, int] = {}
+    due = Job.objects.filter(
+        state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
+    ).exclude(cobot_id__in=busy)
+    for job_id, cobot_id in due.order_by("queued_at", "id").values_list("pk", "cobot_id"):
+        firsts.setdefault(cobot_id, job_id)
+    return list(firsts.values())
+
+
+def _expire_lease(job_id: int, case_id: int) -> None:
+    with transaction.atomic():
+        case = Case.objects.select_for_update().get(pk=case_id)
+        job = Job.objects.select_for_update().select_related("work_item").get(pk=job_id)
+        if (
+            job.state != JobState.RUNNING
+            or job.lease_expires_at is None
+            or job.lease_expires_at >= timezone.now()
+        ):
+            return
+        job.lease_expiries += 1
+        if job.lease_expiries >= MAX_LEASE_EXPIRIES:
+            job.state, job.ended_at = JobState.FAILED, timezone.now()
+            job.save()
+            services.open_incident(
+                case, IncidentKind.LEASE_EXPIRED,
+                f"Workers lost job {job.pk} ({job.work_item.label}) {job.lease_expiries} times; "
+                "check the workers' logs, then retry, skip or cancel.",
+                item=job.work_item,
+            )  # fmt: skip
+        else:
+            job.state, job.next_try_at = JobState.QUEUED, timezone.now()
+            job.save()
+        case.save()
+        dispatch.send_on_commit("run_job", job.pk)
+
+
+# Interruptions (space constraints) ------------------------------------------------------
+
+
+def interrupt_cobot(interruption_id: int) -> None:
+    """Pauses (or slows) the cobot for an interruption still open; never twice."""
+    with transaction.atomic():
+        interruption = (
+            Interruption.objects.select_for_update().select_related("cobot").get(pk=interruption_id)
+        )
+        if interruption.ended_at is not None or interruption.paused_at is not None:
+            return
+        driver = driver_for_cobot(interruption.cobot)
+        try:
+            if interruption.mode == "slow":
+                driver.write({urua.STATE_OVERRIDE: SLOW_OVERRIDE_PERCENT})
+            else:
+                driver.call("PauseProgram")
+        except DriverError as error:
+            interruption.error = f"pause: {error}"
+            interruption.save(update_fields=["error"])
+            return
+        interruption.paused_at = timezone.now()
+        interruption.save(update_fields=["paused_at"])
+
+
+def resume_cobot(interruption_id: int) -> None:
+    """Resumes the cobot after an interruption that paused it, when no other keeps it paused."""
+    with transaction.atomic():
+        interruption = (
+            Interruption.objects.select_for_update().select_related("cobot").get(pk=interruption_id)
+        )
+        if interruption.ended_at is None or interruption.resumed_at is not None:
+            return
+        if interruption.paused_at is not None:
+            others = Interruption.objects.filter(
+                cobot=interruption.cobot, ended_at__isnull=True, paused_at__isnull=False
+            ).exclude(pk=interruption.pk)
+            if not others.exists():
+                driver = driver_for_cobot(interruption.cobot)
+                try:
+                    if interruption.mode == "slow":
+                        driver.write({urua.STATE_OVERRIDE: FULL_OVERRIDE_PERCENT})
+                    else:
+                        driver.call("StartProgram")
+                except DriverError as error:
+                    interruption.error = f"resume: {error}"
+                    interruption.save(update_fields=["error"])
+                    raise
+        interruption.resumed_at = timezone.now()
+        interruption.save(update_fields=["resumed_at"])
+    # The cobot's queue waited for this interruption to settle.
+    job_id = (
+        Job.objects.filter(cobot=interruption.cobot, state=JobState.QUEUED)
+        .values_list("pk", flat=True)
+        .first()
+    )
+    if job_id is not None:
+        with transaction.atomic():
+            dispatch.send_on_commit("run_job", job_id)

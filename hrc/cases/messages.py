@@ -1,0 +1,125 @@
+"""Messages to cases: correlation by name and keys, an early-arrival buffer with a time to live.
+
+A message transition (a silent transition with a `message` configuration)
+waits in a case until a message of its name arrives whose correlation keys
+equal the case's values for them. A message that finds no waiting case is
+kept until it expires; a case that starts waiting takes the oldest matching
+one. The sender's message id makes a repeated send harmless.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Mapping
+from typing import Any
+
+from django.contrib.auth.models import User
+from django.db import IntegrityError, transaction
+from django.utils import timezone
+
+from hrc.cases.choices import CaseStatus, EventType
+from hrc.cases.errors import Invalid
+from hrc.cases.models import Case, Message
+from hrc.cases.nets import case_net
+from hrc.engine.petri import Marking
+from hrc.engine.runtime import CaseNet, correlates
+from hrc.organisations.models import Organisation
+
+DEFAULT_TTL_SECONDS = 3600
+MAX_TTL_SECONDS = 7 * 24 * 3600
+
+
+def receive_message(
+    organisation: Organisation,
+    *,
+    message_id: str,
+    name: str,
+    correlation: Mapping[str, Any] | None = None,
+    payload: Mapping[str, Any] | None = None,
+    ttl_seconds: int = DEFAULT_TTL_SECONDS,
+    sent_by: User | None = None,
+) -> tuple[Message, bool]:
+    """Delivers a message to the case waiting for it, or buffers it. Returns (message, created).
+
+    A message id seen before returns the first message unchanged (created False).
+    """
+    if not message_id or not name:
+        raise Invalid("A message needs a 'message_id' and a 'name'.")
+    if not 1 <= ttl_seconds <= MAX_TTL_SECONDS:
+        raise Invalid(f"'ttl_seconds' must be 1–{MAX_TTL_SECONDS}.")
+    existing = Message.objects.filter(organisation=organisation, message_id=message_id).first()
+    if existing is not None:
+        return existing, False
+    try:
+        with transaction.atomic():
+            message = Message.objects.create(
+                organisation=organisation, message_id=message_id, name=name,
+                correlation=dict(correlation or {}), payload=dict(payload or {}),
+                expires_at=timezone.now() + dt.timedelta(seconds=ttl_seconds), sent_by=sent_by,
+            )  # fmt: skip
+    except IntegrityError:  # the same id, sent twice at once: the other send won
+        return Message.objects.get(organisation=organisation, message_id=message_id), False
+    _deliver(message)
+    return message, True
+
+
+def _deliver(message: Message) -> None:
+    """Offers the message to each running case of the organisation waiting for its name."""
+    from hrc.cases import services
+
+    candidates = Case.objects.filter(
+        organisation_id=message.organisation_id, status=CaseStatus.RUNNING
+    ).values_list("pk", flat=True)
+    for case_id in candidates:
+        with transaction.atomic():
+            case = Case.objects.select_for_update().select_related("version").get(pk=case_id)
+            if case.status != CaseStatus.RUNNING:
+                continue
+            net = case_net(case.version)
+            if take_buffered_message(case, net, only=message.pk):
+                services.advance(case, net)
+                case.save()
+                return
+
+
+def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> bool:
+    """Fires a waiting message transition with the oldest matching unexpired message, if any.
+
+    Call while holding the case row lock. Returns whether a message was taken.
+    """
+    from hrc.cases.services import record_event
+
+    waiting = net.waiting_messages(Marking(case.marking))
+    if not waiting:
+        return False
+    names = {config.name for _, config in waiting}
+    messages = Message.objects.select_for_update(skip_locked=True).filter(
+        organisation_id=case.organisation_id, name__in=names,
+        consumed_at__isnull=True, expires_at__gt=timezone.now(),
+    )  # fmt: skip
+    if only is not None:
+        messages = messages.filter(pk=only)
+    for message in messages.order_by("received_at", "id")[:100]:
+        for transition, config in waiting:
+            if config.name == message.name and correlates(config, case.data, message.correlation):
+                before = Marking(case.marking)
+                after = net.receive(before, transition)
+                case.marking = dict(after)
+                case.data = {**case.data, **message.payload}
+                message.case, message.transition = case, transition
+                message.consumed_at = timezone.now()
+                message.save(update_fields=["case", "transition", "consumed_at"])
+                record_event(
+                    case, EventType.MESSAGE_RECEIVED, task=transition, before=before, after=after,
+                    detail={"message": message.message_id, "name": message.name},
+                )  # fmt: skip
+                return True
+    return False
+
+
+def purge_expired_messages() -> int:
+    """Deletes buffered messages past their time to live that no case took; returns how many."""
+    deleted, _ = Message.objects.filter(
+        consumed_at__isnull=True, expires_at__lte=timezone.now()
+    ).delete()
+    return deleted

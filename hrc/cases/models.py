@@ -1,0 +1,282 @@
+"""Running cases: a published pattern version at work, its work items, jobs, events and incidents.
+
+The rows are the truth. A case's marking and data live on its row, which is
+the lock every change to the case takes (select_for_update); work items are
+the tasks the marking offers; a job is one command to a cobot (a step or a
+device call) and holds its own lease, so a Celery message carries nothing
+but the job's id. Events are appended, never changed: the audit trail and
+the timeline. Writes go through hrc.cases.services only.
+"""
+
+from typing import Any
+
+from django.conf import settings
+from django.db import models
+from django.db.models import Q
+
+from hrc.cases.choices import (
+    OPEN_WORK_ITEM_STATES,
+    CaseStatus,
+    EventType,
+    IncidentKind,
+    InterruptionMode,
+    JobState,
+    Resolution,
+    WorkItemKind,
+    WorkItemState,
+)
+from hrc.cobots.models import Cobot
+from hrc.organisations.models import Organisation, Team
+from hrc.patterns.models import PatternVersion
+
+_USER = settings.AUTH_USER_MODEL
+
+
+class Case(models.Model):
+    organisation = models.ForeignKey(
+        Organisation, on_delete=models.CASCADE, related_name="cases",
+        help_text="The organisation the case runs in; only its members see it.",
+    )  # fmt: skip
+    version = models.ForeignKey(
+        PatternVersion, on_delete=models.PROTECT, related_name="cases",
+        help_text="The published pattern version the case runs.",
+    )  # fmt: skip
+    status = models.CharField(max_length=20, choices=CaseStatus.choices, default=CaseStatus.RUNNING)
+    marking = models.JSONField(default=dict, help_text="Tokens per place of the execution net.")
+    data = models.JSONField(
+        default=dict, blank=True, help_text="The case data tasks read and write."
+    )
+    actor_mapping = models.JSONField(
+        help_text="Who performs each pattern actor: {actor: {users: [ids]} | {team: id} | {cobot: id}}."
+    )
+    started_by = models.ForeignKey(
+        _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    started_at = models.DateTimeField(auto_now_add=True)
+    ended_at = models.DateTimeField(null=True, blank=True)
+    last_seq = models.PositiveIntegerField(
+        default=0, help_text="The sequence number of the case's latest event."
+    )
+
+    class Meta:
+        ordering = ["-started_at", "-id"]
+        indexes = [models.Index(fields=["organisation", "status"])]
+
+    def __str__(self) -> str:
+        return f"case {self.pk} of {self.version}"
+
+
+class WorkItem(models.Model):
+    """One offer of a task in a case: to operators' task lists, or to a cobot's queue."""
+
+    case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="work_items")
+    task = models.CharField(max_length=200, help_text="The pattern transition's id.")
+    label = models.CharField(max_length=300, blank=True)
+    actor = models.CharField(max_length=200, help_text="The pattern actor who performs it.")
+    kind = models.CharField(max_length=20, choices=WorkItemKind.choices)
+    state = models.CharField(
+        max_length=20, choices=WorkItemState.choices, default=WorkItemState.OFFERED
+    )
+    instructions = models.TextField(blank=True)
+    candidates: "models.ManyToManyField[Any, Any]" = models.ManyToManyField(
+        _USER, blank=True, related_name="candidate_work_items",
+        help_text="Operators who may take it (with the team's members, when a team is mapped).",
+    )  # fmt: skip
+    team = models.ForeignKey(Team, on_delete=models.SET_NULL, null=True, blank=True)
+    cobot = models.ForeignKey(Cobot, on_delete=models.PROTECT, null=True, blank=True)
+    claimed_by = models.ForeignKey(
+        _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    completed_by = models.ForeignKey(
+        _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    result = models.JSONField(null=True, blank=True, help_text="Form data or the cobot's answer.")
+    offered_at = models.DateTimeField(auto_now_add=True)
+    started_at = models.DateTimeField(null=True, blank=True)
+    ended_at = models.DateTimeField(null=True, blank=True)
+
+    class Meta:
+        ordering = ["offered_at", "id"]
+        constraints = [
+            # One open offer per task and case: a second offer would let it run twice.
+            models.UniqueConstraint(
+                fields=["case", "task"],
+                condition=Q(state__in=sorted(OPEN_WORK_ITEM_STATES)),
+                name="work_item_one_open_per_task",
+            )
+        ]
+        indexes = [models.Index(fields=["state", "kind"])]
+
+    def __str__(self) -> str:
+        return f"{self.label or self.task} ({self.state})"
+
+
+class Job(models.Model):
+    """A command to a cobot for a work item: the row is the lock, the Celery message only its id.
+
+    The fencing token sent with a step is (id, attempt). `attempt` changes
+    only when a person asks for the step to run again; automatic retries and
+    re-acquired leases keep it, so the cobot recognises a step it has run.
+    `lease` counts acquisitions: a worker whose lease is not the row's any
+    more has lost the job and may change nothing.
+    """
+
+    work_item = models.OneToOneField(WorkItem, on_delete=models.CASCADE, related_name="job")
+    case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="jobs")
+    cobot = models.ForeignKey(Cobot, on_delete=models.PROTECT, related_name="jobs")
+    kind = models.CharField(max_length=20, choices=WorkItemKind.choices)
+    command = models.JSONField(
+        help_text="Step: program, number, workspace, poses. Device: method, args."
+    )
+    state = models.CharField(max_length=20, choices=JobState.choices, default=JobState.QUEUED)
+    attempt = models.PositiveIntegerField(default=1)
+    lease = models.PositiveIntegerField(default=0)
+    lease_expires_at = models.DateTimeField(null=True, blank=True)
+    lease_expiries = models.PositiveIntegerField(default=0)
+    retries_left = models.PositiveIntegerField(default=3)
+    timeout = models.FloatField(help_text="Seconds the step or call may take.")
+    queued_at = models.DateTimeField(auto_now_add=True, help_text="Its place in the cobot's queue.")
+    next_try_at = models.DateTimeField(help_text="Not before: the back-off after a failure.")
+    sent_at = models.DateTimeField(null=True, blank=True, help_text="When a device call went out.")
+    started_at = models.DateTimeField(null=True, blank=True)
+    ended_at = models.DateTimeField(null=True, blank=True)
+    waiting_for = models.CharField(max_length=300, blank=True, help_text="Why it has not started.")
+    last_error = models.TextField(blank=True)
+    result = models.JSONField(null=True, blank=True)
+
+    class Meta:
+        ordering = ["queued_at", "id"]
+        indexes = [models.Index(fields=["cobot", "state", "queued_at"])]
+
+    def __str__(self) -> str:
+        return f"job {self.pk} ({self.kind} on {self.cobot_id}, {self.state})"
+
+    @property
+    def fence(self) -> tuple[int, int]:
+        return (self.pk, self.attempt)
+
+
+class Interruption(models.Model):
+    """A cobot task paused or slowed while an operator works in a shared area (space constraint).
+
+    The pause and the resume are each sent at most once, by tasks that lock
+    this row; a resume that finds no pause sent marks it never needed.
+    """
+
+    case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="interruptions")
+    work_item = models.ForeignKey(WorkItem, on_delete=models.CASCADE, related_name="interruptions")
+    operator_work_item = models.ForeignKey(WorkItem, on_delete=models.CASCADE, related_name="+")
+    cobot = models.ForeignKey(Cobot, on_delete=models.PROTECT, related_name="interruptions")
+    mode = models.CharField(max_length=10, choices=InterruptionMode.choices)
+    started_at = models.DateTimeField(auto_now_add=True)
+    ended_at = models.DateTimeField(null=True, blank=True)
+    paused_at = models.DateTimeField(null=True, blank=True)
+    resumed_at = models.DateTimeField(null=True, blank=True)
+    error = models.TextField(blank=True)
+
+    class Meta:
+        ordering = ["started_at", "id"]
+
+    def __str__(self) -> str:
+        return f"{self.mode} of {self.cobot_id} for work item {self.work_item_id}"
+
+    @property
+    def settled(self) -> bool:
+        """Over, and the cobot no longer paused by it."""
+        return self.ended_at is not None and (self.paused_at is None or self.resumed_at is not None)
+
+
+class Incident(models.Model):
+    """Something a person must decide: retry, skip with given outputs, or cancel the case."""
+
+    case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="incidents")
+    work_item = models.ForeignKey(WorkItem, on_delete=models.CASCADE, null=True, blank=True)
+    kind = models.CharField(max_length=20, choices=IncidentKind.choices)
+    message = models.TextField()
+    cobot_state = models.JSONField(
+        null=True, blank=True, help_text="The cobot's state when it failed."
+    )
+    opened_at = models.DateTimeField(auto_now_add=True)
+    resolved_at = models.DateTimeField(null=True, blank=True)
+    resolution = models.CharField(max_length=10, choices=Resolution.choices, blank=True)
+    resolved_by = models.ForeignKey(
+        _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+
+    class Meta:
+        ordering = ["-opened_at", "-id"]
+
+    def __str__(self) -> str:
+        return f"{self.get_kind_display()} in case {self.case_id}"
+
+
+class ImmutableEventError(Exception):
+    """An event was about to be changed; the log is append-only."""
+
+
+class CaseEvent(models.Model):
+    """One entry of a case's append-only log: who did what, when, and the marking around it."""
+
+    case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="events")
+    seq = models.PositiveIntegerField(help_text="1, 2, 3… within the case.")
+    at = models.DateTimeField()
+    type = models.CharField(max_length=30, choices=EventType.choices)
+    task = models.CharField(max_length=200, blank=True)
+    actor = models.CharField(max_length=200, blank=True, help_text="The pattern actor.")
+    work_item = models.ForeignKey(
+        WorkItem, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    user = models.ForeignKey(
+        _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    marking_before = models.JSONField(default=dict)
+    marking_after = models.JSONField(default=dict)
+    detail = models.JSONField(default=dict, blank=True)
+
+    class Meta:
+        ordering = ["case", "seq"]
+        constraints = [
+            models.UniqueConstraint(fields=["case", "seq"], name="case_event_seq_unique")
+        ]
+
+    def __str__(self) -> str:
+        return f"{self.seq}. {self.type} {self.task}".strip()
+
+    def save(self, *args: Any, **kwargs: Any) -> None:
+        if not self._state.adding:
+            raise ImmutableEventError(f"Event {self.seq} of case {self.case_id} cannot be changed.")
+        super().save(*args, **kwargs)
+
+
+class Message(models.Model):
+    """A message sent to cases (POST /api/messages/); kept until consumed or expired."""
+
+    organisation = models.ForeignKey(
+        Organisation, on_delete=models.CASCADE, related_name="messages"
+    )
+    message_id = models.CharField(
+        max_length=200, help_text="The sender's id: a repeated send with it changes nothing."
+    )
+    name = models.CharField(max_length=200)
+    correlation = models.JSONField(default=dict, blank=True)
+    payload = models.JSONField(default=dict, blank=True)
+    received_at = models.DateTimeField(auto_now_add=True)
+    expires_at = models.DateTimeField()
+    case = models.ForeignKey(
+        Case, on_delete=models.SET_NULL, null=True, blank=True, related_name="messages"
+    )
+    transition = models.CharField(max_length=200, blank=True)
+    consumed_at = models.DateTimeField(null=True, blank=True)
+    sent_by = models.ForeignKey(_USER, on_delete=models.SET_NULL, null=True, related_name="+")
+
+    class Meta:
+        ordering = ["received_at", "id"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["organisation", "message_id"], name="message_id_unique_in_organisation"
+            )
+        ]
+        indexes = [models.Index(fields=["organisation", "name", "consumed_at"])]
+
+    def __str__(self) -> str:
+        return f"{self.name} ({self.message_id})"

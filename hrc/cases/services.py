@@ -1,0 +1,667 @@
+"""Every write to a case: start, advance, work items, incidents, cancel, suspend, resume.
+
+Each public function takes the case row lock (select_for_update) for its
+whole transaction, so two tablets, a worker and a message can never change
+one case at once; the engine's CaseNet decides what the marking allows.
+Lock order, everywhere: cobot row, then case row, then job row, then
+interruption row. Broadcast and dispatch happen after commit (dispatch.py).
+
+Errors: CaseError subclasses, each with the HTTP status the API answers:
+Conflict (409: the case or work item has moved on), NotAllowed (403: not
+this user's task), Invalid (400: the input is wrong).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import jsonschema
+from django.contrib.auth.models import User
+from django.db import transaction
+from django.db.models import Q
+from django.utils import timezone
+
+from hrc.cases import dispatch
+from hrc.cases.choices import (
+    OPEN_CASE_STATUSES,
+    OPEN_WORK_ITEM_STATES,
+    CaseStatus,
+    EventType,
+    IncidentKind,
+    JobState,
+    Resolution,
+    WorkItemKind,
+    WorkItemState,
+)
+from hrc.cases.errors import Conflict, Invalid, NotAllowed
+from hrc.cases.mapping import resolve_actor_mapping
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
+from hrc.cases.nets import case_net
+from hrc.engine.petri import Marking
+from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, resolve
+from hrc.engine.taskconfig import POSE_LENGTH, TaskConfig
+from hrc.organisations.models import Membership
+from hrc.patterns.models import PatternVersion
+
+# advance() repeats settle → messages → held completions until nothing changes;
+# each round consumes a token or a message, so a sound net stops long before this.
+MAX_ROUNDS = 10_000
+
+
+# Starting and ending cases ----------------------------------------------------------
+
+
+def start_case(
+    version: PatternVersion,
+    *,
+    started_by: User | None,
+    actor_mapping: Mapping[str, Any] | None = None,
+    data: Mapping[str, Any] | None = None,
+) -> Case:
+    """Starts a case of a published version; the mapping overrides the version's defaults per actor.
+
+    Raises Invalid when an actor is left unmapped or mapped to someone outside the organisation.
+    """
+    net = case_net(version)
+    organisation = version.pattern.organisation
+    mapping = {**(version.default_actor_mapping or {}), **(actor_mapping or {})}
+    mapping = resolve_actor_mapping(net.pattern, organisation, mapping)
+    if data is not None and not isinstance(data, Mapping):
+        raise Invalid("The case data must be a JSON object.")
+    with transaction.atomic():
+        case = Case.objects.create(
+            organisation=organisation,
+            version=version,
+            marking=dict(net.initial),
+            data=dict(data or {}),
+            actor_mapping=mapping,
+            started_by=started_by,
+        )
+        case = Case.objects.select_for_update().get(pk=case.pk)
+        record_event(case, EventType.CASE_STARTED, user=started_by, after=net.initial)
+        advance(case, net)
+        case.save()
+    return case
+
+
+def set_default_actor_mapping(
+    version: PatternVersion, mapping: Mapping[str, Any]
+) -> PatternVersion:
+    """Sets who performs each actor in the version's cases unless a case says otherwise.
+
+    Raises Invalid as start_case does. Only this field of a version ever changes.
+    """
+    resolved = resolve_actor_mapping(
+        case_net(version).pattern, version.pattern.organisation, mapping
+    )
+    PatternVersion.objects.filter(pk=version.pk).update(default_actor_mapping=resolved)
+    version.default_actor_mapping = resolved
+    return version
+
+
+def cancel_case(case: Case, *, by: User | None, reason: str = "") -> Case:
+    """Cancels an open case: open work is withdrawn and queued jobs are cancelled.
+
+    A step already running on a cobot finishes (the cobot is not stopped by
+    this); its result is then ignored. Raises Conflict when the case has ended.
+    """
+    with transaction.atomic():
+        case = _locked(case.pk)
+        _check_open(case)
+        _end(case, CaseStatus.CANCELLED, EventType.CASE_CANCELLED, by, {"reason": reason})
+        case.save()
+    return case
+
+
+def suspend_case(case: Case, *, by: User | None) -> Case:
+    """Stops offering and dispatching new work; tasks already running may finish."""
+    with transaction.atomic():
+        case = _locked(case.pk)
+        if case.status != CaseStatus.RUNNING:
+            raise Conflict(f"Case {case.pk} is {case.status}, not running: it cannot be suspended.")
+        case.status = CaseStatus.SUSPENDED
+        record_event(case, EventType.CASE_SUSPENDED, user=by)
+        case.save()
+    return case
+
+
+def resume_case(case: Case, *, by: User | None) -> Case:
+    with transaction.atomic():
+        case = _locked(case.pk)
+        if case.status != CaseStatus.SUSPENDED:
+            raise Conflict(f"Case {case.pk} is {case.status}, not suspended.")
+        case.status = CaseStatus.RUNNING
+        record_event(case, EventType.CASE_RESUMED, user=by)
+        advance(case, case_net(case.version))
+        _dispatch_queues(case)
+        case.save()
+    return case
+
+
+# Operator work items ---------------------------------------------------------------
+
+
+def may_perform(user: User, item: WorkItem) -> bool:
+    """Whether the user is one of the operator work item's candidates (directly or by team)."""
+    if item.candidates.filter(pk=user.pk).exists():
+        return True
+    return (
+        item.team_id is not None
+        and Membership.objects.filter(user_id=user.pk, teams__id=item.team_id).exists()
+    )
+
+
+def claim_work_item(item: WorkItem, *, user: User) -> WorkItem:
+    """Takes an offered operator task for `user`; Conflict when someone else has it."""
+    with transaction.atomic():
+        case, item = _locked_item(item, user)
+        if item.state != WorkItemState.OFFERED:
+            raise Conflict(_moved_on(item, "claimed"))
+        item.state, item.claimed_by = WorkItemState.CLAIMED, user
+        item.save(update_fields=["state", "claimed_by"])
+        record_event(case, EventType.TASK_CLAIMED, item=item, user=user)
+        case.save()
+    return item
+
+
+def unclaim_work_item(item: WorkItem, *, user: User) -> WorkItem:
+    """Gives a claimed, not yet started task back to its candidates."""
+    with transaction.atomic():
+        case, item = _locked_item(item, user)
+        if item.state != WorkItemState.CLAIMED or item.claimed_by_id != user.pk:
+            raise Conflict(_moved_on(item, "unclaimed by you"))
+        item.state, item.claimed_by = WorkItemState.OFFERED, None
+        item.save(update_fields=["state", "claimed_by"])
+        record_event(case, EventType.TASK_UNCLAIMED, item=item, user=user)
+        case.save()
+    return item
+
+
+def start_work_item(item: WorkItem, *, user: User) -> WorkItem:
+    """Starts an operator task (claiming it if nobody has); the other tasks of a choice withdraw."""
+    with transaction.atomic():
+        case, item = _locked_item(item, user)
+        if item.state == WorkItemState.CLAIMED and item.claimed_by_id != user.pk:
+            raise Conflict(f"{item.label} is claimed by someone else.")
+        if item.state not in (WorkItemState.OFFERED, WorkItemState.CLAIMED):
+            raise Conflict(_moved_on(item, "started"))
+        if case.status != CaseStatus.RUNNING:
+            raise Conflict(f"Case {case.pk} is {case.status}: nothing can start now.")
+        net = case_net(case.version)
+        try:
+            _start(case, net, item, user)
+        except NotEnabled as refused:
+            raise Conflict(str(refused)) from None
+        item.claimed_by = user
+        item.save(update_fields=["state", "started_at", "claimed_by"])
+        advance(case, net)
+        case.save()
+    return item
+
+
+def complete_work_item(
+    item: WorkItem, *, user: User, data: Mapping[str, Any] | None = None
+) -> WorkItem:
+    """Completes a running operator task with its form data (checked against the task's form).
+
+    Raises Invalid naming each field the form refuses, Conflict when the task
+    is not running (someone completed it already) or a func constraint still holds it.
+    """
+    with transaction.atomic():
+        case, item = _locked_item(item, user)
+        if item.state != WorkItemState.RUNNING:
+            raise Conflict(_moved_on(item, "completed"))
+        if item.claimed_by_id != user.pk:
+            raise Conflict(f"{item.label} is being done by someone else.")
+        net = case_net(case.version)
+        result = dict(data or {})
+        _check_form(net.tasks[item.task], result)
+        try:
+            _complete(case, net, item, result, user)
+        except NotEnabled as refused:
+            raise Conflict(str(refused)) from None
+        advance(case, net)
+        case.save()
+    return item
+
+
+def _check_form(config: TaskConfig, data: Mapping[str, Any]) -> None:
+    if config.form is None:
+        return
+    validator = jsonschema.Draft202012Validator(config.form)
+    problems = sorted(validator.iter_errors(data), key=lambda e: list(e.absolute_path))
+    if problems:
+        raise Invalid(
+            "The form is not filled in correctly: "
+            + "; ".join(f"{_field(p.absolute_path)}: {p.message}" for p in problems)
+        )
+
+
+def _field(path: Iterable[Any]) -> str:
+    return ".".join(str(part) for part in path) or "the form"
+
+
+# Incidents ------------------------------------------------------------------------
+
+
+def open_incident(
+    case: Case,
+    kind: IncidentKind,
+    message: str,
+    *,
+    item: WorkItem | None = None,
+    cobot_state: Mapping[str, Any] | None = None,
+) -> Incident:
+    """Records an incident. Call while holding the case row lock."""
+    incident = Incident.objects.create(
+        case=case, work_item=item, kind=kind, message=message,
+        cobot_state=dict(cobot_state) if cobot_state else None,
+    )  # fmt: skip
+    record_event(
+        case,
+        EventType.INCIDENT_OPENED,
+        item=item,
+        detail={"incident": incident.pk, "kind": kind, "message": message},
+    )
+    return incident
+
+
+def resolve_incident(
+    incident: Incident,
+    *,
+    by: User,
+    resolution: str,
+    outputs: Mapping[str, Any] | None = None,
+    again: bool = False,
+) -> Incident:
+    """Retry (the job is queued again; `again` runs a step that ran once more), skip (the task
+    completes with `outputs`), or cancel the case. Conflict when it is resolved already.
+    """
+    if resolution not in Resolution.values:
+        raise Invalid(
+            f"resolution must be one of {', '.join(Resolution.values)}, not {resolution!r}."
+        )
+    with transaction.atomic():
+        case = _locked(incident.case_id)
+        incident = Incident.objects.select_for_update().get(pk=incident.pk)
+        if incident.resolved_at is not None:
+            raise Conflict(f"Incident {incident.pk} was resolved already ({incident.resolution}).")
+        item = incident.work_item
+        if resolution != Resolution.CANCEL:
+            _check_open(case)
+            if item is None or item.state not in OPEN_WORK_ITEM_STATES:
+                raise Conflict(
+                    "Only cancel resolves this incident: it has no open task to retry or skip."
+                )
+        net = case_net(case.version)
+        if resolution == Resolution.CANCEL:
+            if case.status in OPEN_CASE_STATUSES:
+                _end(
+                    case,
+                    CaseStatus.CANCELLED,
+                    EventType.CASE_CANCELLED,
+                    by,
+                    {"incident": incident.pk},
+                )
+        elif resolution == Resolution.RETRY:
+            _retry(case, net, item, again)  # type: ignore[arg-type]
+        else:
+            _skip(case, net, item, dict(outputs or {}), by)  # type: ignore[arg-type]
+        incident.resolution, incident.resolved_by = resolution, by
+        incident.resolved_at = timezone.now()
+        incident.save(update_fields=["resolution", "resolved_by", "resolved_at"])
+        record_event(
+            case,
+            EventType.INCIDENT_RESOLVED,
+            item=item,
+            user=by,
+            detail={"incident": incident.pk, "resolution": resolution},
+        )
+        case.save()
+    return incident
+
+
+def _retry(case: Case, net: CaseNet, item: WorkItem, again: bool) -> None:
+    job = Job.objects.select_for_update().filter(work_item=item).first()
+    if job is None:
+        raise Conflict(f"{item.label} is an operator task: there is nothing to retry.")
+    if job.state == JobState.RUNNING:
+        raise Conflict(f"{item.label} is running again already.")
+    command = (
+        _command(net, item.task, case.data)
+        if job.state == JobState.FAILED and not job.command
+        else job.command
+    )
+    job.command = command
+    job.state, job.retries_left, job.lease_expiries = (
+        JobState.QUEUED,
+        net.tasks[item.task].retries,
+        0,
+    )
+    job.next_try_at, job.last_error = timezone.now(), ""
+    if again:
+        job.attempt += 1
+    job.save()
+    dispatch.send_on_commit("run_job", job.pk)
+
+
+def _skip(case: Case, net: CaseNet, item: WorkItem, outputs: dict[str, Any], by: User) -> None:
+    Job.objects.filter(work_item=item).exclude(state=JobState.SUCCEEDED).update(
+        state=JobState.CANCELLED, ended_at=timezone.now()
+    )
+    if item.state != WorkItemState.RUNNING:
+        try:
+            _start(case, net, item, by)
+        except NotEnabled as refused:
+            raise Conflict(f"{item.label} cannot be skipped now: {refused}") from None
+    try:
+        _complete(case, net, item, outputs, by)
+    except NotEnabled as refused:
+        raise Conflict(f"{item.label} cannot be skipped now: {refused}") from None
+    advance(case, net)
+
+
+# The engine's firing rule applied to the rows ----------------------------------------
+
+
+def advance(case: Case, net: CaseNet) -> None:
+    """Fires what fires by itself and brings the work items in line with the marking.
+
+    Silent transitions fire, buffered messages are taken, cobot tasks whose
+    step is done complete once their func constraints allow; then the case
+    completes, or tasks that became startable are offered and those that
+    stopped being startable are withdrawn. Call while holding the case row
+    lock; the caller saves the case.
+    """
+    if case.status not in OPEN_CASE_STATUSES:
+        return
+    from hrc.cases.messages import take_buffered_message  # messages build on these services
+
+    try:
+        for _ in range(MAX_ROUNDS):
+            fired = _settle(case, net)
+            taken = take_buffered_message(case, net)
+            held = _complete_held_steps(case, net)
+            if not (fired or taken or held):
+                break
+    except RuntimeFault as fault:
+        _fail(case, str(fault))
+        return
+    marking = Marking(case.marking)
+    if net.is_final(marking):
+        _end(case, CaseStatus.COMPLETED, EventType.CASE_COMPLETED, None, {})
+        return
+    if case.status == CaseStatus.RUNNING:
+        _offer_and_withdraw(case, net, marking)
+
+
+def _settle(case: Case, net: CaseNet) -> bool:
+    before = Marking(case.marking)
+    after, fired = net.settle(before, case.data)
+    marking = before
+    for transition in fired:
+        after_one = net.transition(transition).fire(marking)
+        record_event(
+            case, EventType.TRANSITION_FIRED, task=transition, before=marking, after=after_one
+        )
+        marking = after_one
+    case.marking = dict(after)
+    return bool(fired)
+
+
+def _complete_held_steps(case: Case, net: CaseNet) -> bool:
+    """Completes cobot tasks whose step is done and whose func constraints now allow it."""
+    done = False
+    held = WorkItem.objects.filter(
+        case=case, state=WorkItemState.RUNNING, job__state=JobState.SUCCEEDED
+    ).select_related("job")
+    for item in held:
+        if net.can_complete(Marking(case.marking), item.task):
+            _complete(case, net, item, item.job.result or {}, None)
+            done = True
+    return done
+
+
+def _offer_and_withdraw(case: Case, net: CaseNet, marking: Marking) -> None:
+    startable = set(net.startable(marking))
+    open_items = {
+        item.task: item
+        for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES)
+    }
+    for task, item in open_items.items():
+        if item.state != WorkItemState.RUNNING and task not in startable:
+            _withdraw(case, item, "another task took its turn")
+    for task in net.startable(marking):
+        if task not in open_items:
+            _offer(case, net, task)
+    if not startable and not open_items and not net.waiting_messages(marking):
+        _fail(
+            case,
+            f"The case cannot go on: nothing can start in marking {dict(marking)} "
+            "(a guard that holds for no branch?).",
+        )
+
+
+def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
+    config = net.tasks[task]
+    actor = net.performers[task]
+    binding = case.actor_mapping[actor]
+    item = WorkItem.objects.create(
+        case=case, task=task, label=net.labels[task], actor=actor,
+        kind=config.kind, instructions=config.instructions,
+        team_id=binding.get("team"), cobot_id=binding.get("cobot"),
+    )  # fmt: skip
+    if config.kind == "operator":
+        if binding.get("users"):
+            item.candidates.set(binding["users"])
+    else:
+        _queue_job(case, net, item, config)
+    record_event(case, EventType.TASK_OFFERED, item=item)
+    return item
+
+
+def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> None:
+    assert item.cobot_id is not None  # a cobot task's actor maps to a cobot (mapping.py)
+    now = timezone.now()
+    job = Job(
+        work_item=item, case=case, cobot_id=item.cobot_id, kind=config.kind,
+        timeout=config.timeout, retries_left=config.retries, next_try_at=now, command={},
+    )  # fmt: skip
+    try:
+        job.command = _command(net, item.task, case.data)
+    except RuntimeFault as fault:
+        job.state, job.last_error = JobState.FAILED, str(fault)
+        job.save()
+        open_incident(case, IncidentKind.CASE_FAULT, str(fault), item=item)
+        return
+    job.save()
+    dispatch.send_on_commit("run_job", job.pk)
+
+
+def _command(net: CaseNet, task: str, data: Mapping[str, Any]) -> dict[str, Any]:
+    """The job's command with its expressions evaluated over the case data now."""
+    config = net.tasks[task]
+    if config.device is not None:
+        device = config.device
+        args = [resolve(task, device.args[name], data) for name in device.argument_names]
+        return {"method": device.method, "args": args, "outputs": list(device.output_names)}
+    assert config.step is not None
+    step = config.step
+    poses = resolve(task, step.poses, data)
+    flat = [float(v) for pose in poses for v in pose] if poses else []
+    if len(flat) > 2 * POSE_LENGTH or len(flat) % POSE_LENGTH:
+        raise RuntimeFault(
+            f"{task}: the poses resolved to {poses!r}, not one or two 6-value poses."
+        )
+    return {
+        "program": step.program,
+        "number": _whole(task, "number", resolve(task, step.number, data)),
+        "workspace": _whole(task, "workspace", resolve(task, step.workspace, data)),
+        "poses": flat + [0.0] * (2 * POSE_LENGTH - len(flat)),
+    }
+
+
+def _whole(task: str, what: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | float) or int(value) != value:
+        raise RuntimeFault(f"{task}: the step {what} resolved to {value!r}, not a whole number.")
+    return int(value)
+
+
+def _withdraw(case: Case, item: WorkItem, why: str) -> None:
+    item.state, item.ended_at = WorkItemState.WITHDRAWN, timezone.now()
+    item.save(update_fields=["state", "ended_at"])
+    Job.objects.filter(work_item=item, state__in=[JobState.QUEUED, JobState.FAILED]).update(
+        state=JobState.CANCELLED, ended_at=item.ended_at
+    )
+    Incident.objects.filter(work_item=item, resolved_at__isnull=True).update(
+        resolved_at=item.ended_at, resolution=Resolution.CANCEL
+    )
+    record_event(case, EventType.TASK_WITHDRAWN, item=item, detail={"why": why})
+
+
+def _start(case: Case, net: CaseNet, item: WorkItem, user: User | None) -> None:
+    """Fires the task's start; interrupts the cobots it shares a space with. Raises NotEnabled."""
+    before = Marking(case.marking)
+    after = net.start(before, item.task)
+    case.marking = dict(after)
+    item.state, item.started_at = WorkItemState.RUNNING, timezone.now()
+    record_event(case, EventType.TASK_STARTED, item=item, user=user, before=before, after=after)
+    if item.kind == WorkItemKind.OPERATOR:
+        _interrupt_shared_space(case, net, item)
+
+
+def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
+    """Starts a cobot task as its cobot takes the job (jobs.lease_next_job).
+
+    Call while holding the case row lock, with the start enabled; the caller saves the case.
+    """
+    _start(case, net, item, None)
+    item.save(update_fields=["state", "started_at"])
+    advance(case, net)
+
+
+def _complete(
+    case: Case,
+    net: CaseNet,
+    item: WorkItem,
+    result: Mapping[str, Any],
+    user: User | None,
+) -> None:
+    """Fires the task's completion and maps its outputs into the case data. Raises NotEnabled."""
+    before = Marking(case.marking)
+    after = net.complete(before, item.task)
+    try:
+        case.data = apply_outputs(net.tasks[item.task], item.task, result, case.data)
+    except RuntimeFault as fault:
+        raise Invalid(str(fault)) from None
+    case.marking = dict(after)
+    item.state, item.ended_at = WorkItemState.COMPLETED, timezone.now()
+    item.result, item.completed_by = dict(result), user
+    item.save(update_fields=["state", "ended_at", "result", "completed_by", "started_at"])
+    record_event(case, EventType.TASK_COMPLETED, item=item, user=user, before=before, after=after)
+    _end_interruptions(case, Q(work_item=item) | Q(operator_work_item=item))
+
+
+# Space constraints: interruptions ------------------------------------------------------
+
+
+def _interrupt_shared_space(case: Case, net: CaseNet, operator_item: WorkItem) -> None:
+    for pair in net.space_pairs:
+        if pair.operator_task != operator_item.task:
+            continue
+        cobot_item = WorkItem.objects.filter(
+            case=case, task=pair.cobot_task, state=WorkItemState.RUNNING
+        ).first()
+        if cobot_item is None or cobot_item.cobot_id is None:
+            continue  # not running: the cobot's job waits for the operator instead (jobs.py)
+        interruption = Interruption.objects.create(
+            case=case, work_item=cobot_item, operator_work_item=operator_item,
+            cobot_id=cobot_item.cobot_id, mode=pair.mode,
+        )  # fmt: skip
+        record_event(case, EventType.TASK_INTERRUPTED, item=cobot_item,
+                detail={"interruption": interruption.pk, "by": operator_item.task, "mode": pair.mode})  # fmt: skip
+        dispatch.send_on_commit("interrupt_cobot", interruption.pk)
+
+
+def _end_interruptions(case: Case, which: Q) -> None:
+    for interruption in Interruption.objects.filter(which, case=case, ended_at__isnull=True):
+        interruption.ended_at = timezone.now()
+        interruption.save(update_fields=["ended_at"])
+        seconds = (interruption.ended_at - interruption.started_at).total_seconds()
+        record_event(case, EventType.TASK_RESUMED, item=interruption.work_item,
+                detail={"interruption": interruption.pk, "seconds": round(seconds, 3)})  # fmt: skip
+        dispatch.send_on_commit("resume_cobot", interruption.pk)
+
+
+def _dispatch_queues(case: Case) -> None:
+    """Rings the doorbell of each cobot the case has queued work for."""
+    for job_id in Job.objects.filter(case=case, state=JobState.QUEUED).values_list("pk", flat=True):
+        dispatch.send_on_commit("run_job", job_id)
+
+
+# Case endings, locks, the event log ---------------------------------------------------
+
+
+def _end(case: Case, status: str, event: str, by: User | None, detail: dict[str, Any]) -> None:
+    for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES):
+        _withdraw(case, item, f"the case is {status}")
+    _end_interruptions(case, Q())
+    case.status, case.ended_at = status, timezone.now()
+    record_event(case, event, user=by, detail=detail)
+
+
+def _fail(case: Case, message: str) -> None:
+    open_incident(case, IncidentKind.CASE_FAULT, message)
+    _end(case, CaseStatus.FAILED, EventType.CASE_FAILED, None, {"message": message})
+
+
+def _locked(case_id: int) -> Case:
+    return Case.objects.select_for_update().select_related("version").get(pk=case_id)
+
+
+def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:
+    """The case (locked) and a fresh copy of an operator work item the user may perform."""
+    case = _locked(item.case_id)
+    item = WorkItem.objects.get(pk=item.pk)
+    if item.kind != WorkItemKind.OPERATOR:
+        raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+    if not may_perform(user, item):
+        raise NotAllowed(f"{item.label} is not offered to you.")
+    return case, item
+
+
+def _check_open(case: Case) -> None:
+    if case.status not in OPEN_CASE_STATUSES:
+        raise Conflict(f"Case {case.pk} has ended ({case.status}).")
+
+
+def _moved_on(item: WorkItem, wanted: str) -> str:
+    return f"{item.label} cannot be {wanted}: it is {item.state} now."
+
+
+def record_event(
+    case: Case,
+    event: str,
+    *,
+    item: WorkItem | None = None,
+    task: str = "",
+    user: User | None = None,
+    before: Marking | None = None,
+    after: Marking | None = None,
+    detail: Mapping[str, Any] | None = None,
+) -> CaseEvent:
+    """Appends an event; the case's counter gives its number, so its cost never grows with the log.
+
+    Call while holding the case row lock; the caller saves the case (its last_seq).
+    """
+    case.last_seq += 1
+    marking = dict(case.marking)
+    return CaseEvent.objects.create(
+        case=case, seq=case.last_seq, at=timezone.now(), type=event,
+        task=item.task if item else task, actor=item.actor if item else "",
+        work_item=item, user=user if user is not None and user.is_authenticated else None,
+        marking_before=dict(before) if before is not None else marking,
+        marking_after=dict(after) if after is not None else marking,
+        detail=dict(detail or {}),
+    )  # fmt: skip

@@ -1,0 +1,36 @@
+"""Celery tasks of the cases app: thin, idempotent, ids only; the logic is in jobs.py.
+
+A task may run twice (a redelivery, the sweeper ringing again): each one
+re-reads the rows and does nothing when there is nothing to do.
+"""
+
+from celery import shared_task
+
+from hrc.cases import jobs
+from hrc.cases.messages import purge_expired_messages
+
+
+@shared_task(ignore_result=True)
+def run_job(job_id: int) -> None:
+    """Rings a cobot's doorbell: runs its next job that may run (not necessarily `job_id`)."""
+    jobs.run_next_job(job_id)
+
+
+@shared_task(ignore_result=True)
+def sweep() -> dict[str, int]:
+    return jobs.sweep()
+
+
+@shared_task(ignore_result=True)
+def interrupt_cobot(interruption_id: int) -> None:
+    jobs.interrupt_cobot(interruption_id)
+
+
+@shared_task(ignore_result=True, autoretry_for=(Exception,), retry_backoff=True, max_retries=5)
+def resume_cobot(interruption_id: int) -> None:
+    jobs.resume_cobot(interruption_id)
+
+
+@shared_task(ignore_result=True)
+def purge_messages() -> int:
+    return purge_expired_messages()

@@ -1,0 +1,232 @@
+"""The firing rule at run time: what a running case may start, complete or fire next.
+
+A `CaseNet` is a published pattern compiled once for running: its execution
+net (execution.py), each task's configuration, the guards and messages of
+its silent transitions, and the operator/cobot pairs of its space
+constraints. It holds no case state: every method takes the marking (and
+case data) and returns the next marking, so the database row stays the one
+truth and the same rule serves the runtime, the token game and the tests.
+
+- Silent transitions fire at once (`settle`), in net order, when their guard
+  holds; a message transition waits for its message instead.
+- A task whose start is enabled is offered; starting one consumes its input
+  tokens, so the other tasks of a deferred choice are no longer startable.
+- time and func constraints are places of the execution net, so `start` and
+  `complete` enforce them; space constraints are the runtime's to honour
+  (`space_partners`).
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Final
+
+from hrc.engine import expressions
+from hrc.engine.execution import build_execution_net, constraint_places
+from hrc.engine.model import Pattern
+from hrc.engine.petri import Marking, NetTransition
+from hrc.engine.taskconfig import (
+    MessageConfig,
+    TaskConfig,
+    guard_of,
+    message_of,
+    task_config,
+)
+
+# A guard-driven loop of silent transitions that never stops is a modelling
+# fault; the runtime stops it here rather than spin.
+MAX_SILENT_FIRINGS: Final = 1000
+
+
+class RuntimeFault(Exception):
+    """The case cannot go on as modelled (a guard failed, a silent loop never ends)."""
+
+
+class NotEnabled(Exception):
+    """A start, completion or message firing that the marking does not allow; says why."""
+
+
+@dataclass(frozen=True)
+class SpacePair:
+    """A space constraint's operator task and cobot task."""
+
+    operator_task: str
+    cobot_task: str
+    mode: str  # "pause" or "slow": how the cobot is interrupted
+
+
+class CaseNet:
+    def __init__(self, pattern: Pattern) -> None:
+        self.pattern = pattern
+        self.net = build_execution_net(pattern)
+        self._transitions = {t.id: t for t in self.net.transitions}
+        self._needs = {place: c.needed() for place, c in constraint_places(pattern).items()}
+        self.tasks: dict[str, TaskConfig] = {}
+        self.performers: dict[str, str] = {}
+        self.labels: dict[str, str] = {}
+        self.guards: dict[str, str] = {}
+        self.messages: dict[str, MessageConfig] = {}
+        for _, transition in pattern.transitions():
+            self.labels[transition.id] = transition.label or transition.id
+            if transition.performer is not None:
+                self.tasks[transition.id] = task_config(pattern, transition)
+                self.performers[transition.id] = transition.performer
+                continue
+            guard = guard_of(transition)
+            if guard is not None:
+                self.guards[transition.id] = guard
+            message = message_of(transition)
+            if message is not None:
+                self.messages[transition.id] = message
+        self.space_pairs = self._space_pairs()
+
+    def _space_pairs(self) -> tuple[SpacePair, ...]:
+        pairs = []
+        for constraint in self.pattern.constraints:
+            if constraint.type != "space":
+                continue
+            kinds = {self.actor_type(t): t for t in constraint.elements}
+            if set(kinds) == {"operator", "cobot"}:
+                mode = "slow" if constraint.extra.get("interrupt") == "slow" else "pause"
+                pairs.append(SpacePair(kinds["operator"], kinds["cobot"], mode))
+        return tuple(pairs)
+
+    def transition(self, transition_id: str) -> NetTransition:
+        return self._transitions[transition_id]
+
+    def actor_type(self, task: str) -> str | None:
+        actor = self.pattern.actor(self.performers.get(task, ""))
+        return actor.type if actor else None
+
+    @property
+    def initial(self) -> Marking:
+        return self.net.initial
+
+    def is_final(self, marking: Marking) -> bool:
+        return self.net.is_final(marking)
+
+    # Silent transitions ------------------------------------------------------------
+
+    def settle(self, marking: Marking, data: Mapping[str, Any]) -> tuple[Marking, list[str]]:
+        """Fires enabled silent transitions (guard holding, no message awaited) until none is left.
+
+        Returns the marking and the transitions fired, in order. Raises
+        RuntimeFault when a guard cannot be evaluated or silent firings do not stop.
+        """
+        fired: list[str] = []
+        while True:
+            transition = self._next_silent(marking, data)
+            if transition is None:
+                return marking, fired
+            if len(fired) >= MAX_SILENT_FIRINGS:
+                raise RuntimeFault(
+                    f"Silent transitions fired {MAX_SILENT_FIRINGS} times in a row "
+                    f"({', '.join(fired[-3:])}, …): a loop whose guards never stop it."
+                )
+            marking = transition.fire(marking)
+            fired.append(transition.id)
+
+    def _next_silent(self, marking: Marking, data: Mapping[str, Any]) -> NetTransition | None:
+        for transition in self.net.transitions:
+            if transition.kind != "silent" or transition.id in self.messages:
+                continue
+            if transition.is_enabled(marking) and self._guard_holds(transition.id, data):
+                return transition
+        return None
+
+    def _guard_holds(self, transition: str, data: Mapping[str, Any]) -> bool:
+        guard = self.guards.get(transition)
+        if guard is None:
+            return True
+        try:
+            return bool(expressions.evaluate(guard, {"data": data}))
+        except expressions.ExpressionError as problem:
+            raise RuntimeFault(f"The guard of {transition} failed: {problem}") from None
+
+    def waiting_messages(self, marking: Marking) -> list[tuple[str, MessageConfig]]:
+        """The message transitions enabled in `marking`: what the case waits to hear."""
+        return [
+            (t, message)
+            for t, message in self.messages.items()
+            if self._transitions[t].is_enabled(marking)
+        ]
+
+    def receive(self, marking: Marking, transition: str) -> Marking:
+        """Fires a message transition; raises NotEnabled when the case is not waiting for it."""
+        return self._fire(marking, transition, f"the message of {transition}")
+
+    # Tasks -------------------------------------------------------------------------
+
+    def startable(self, marking: Marking) -> list[str]:
+        """Tasks whose start is enabled, in net order: the work the case offers now."""
+        return [t.task for t in self.net.transitions if t.kind == "start" and t.is_enabled(marking)]
+
+    def can_start(self, marking: Marking, task: str) -> bool:
+        return self._transitions[f"start:{task}"].is_enabled(marking)
+
+    def can_complete(self, marking: Marking, task: str) -> bool:
+        return self._transitions[f"complete:{task}"].is_enabled(marking)
+
+    def start(self, marking: Marking, task: str) -> Marking:
+        return self._fire(marking, f"start:{task}", f"{task} cannot start")
+
+    def complete(self, marking: Marking, task: str) -> Marking:
+        return self._fire(marking, f"complete:{task}", f"{task} cannot complete")
+
+    def why_not(self, marking: Marking, transition: str) -> str:
+        """What a transition waits for, as a person says it; "" when it is enabled."""
+        missing = [
+            self._needs.get(place, f"a token in {place}")
+            for place, weight in self._transitions[transition].pre
+            if marking.get(place) < weight
+        ]
+        return "; ".join(missing)
+
+    def _fire(self, marking: Marking, transition: str, what: str) -> Marking:
+        net_transition = self._transitions.get(transition)
+        if net_transition is None:
+            raise NotEnabled(f"{what}: the pattern has no {transition}.")
+        if not net_transition.is_enabled(marking):
+            raise NotEnabled(f"{what}: it waits for {self.why_not(marking, transition)}.")
+        return net_transition.fire(marking)
+
+
+def apply_outputs(
+    config: TaskConfig, task: str, result: Mapping[str, Any], data: Mapping[str, Any]
+) -> dict[str, Any]:
+    """The case data after a task: its outputs mapped in, or the whole result under its id.
+
+    Raises RuntimeFault when an output expression fails on this result.
+    """
+    updated = dict(data)
+    if config.outputs is None:
+        if result:
+            updated[task] = dict(result)
+        return updated
+    names = {"data": data, "result": result}
+    for key, text in config.outputs.items():
+        try:
+            updated[key] = expressions.evaluate(text, names)
+        except expressions.ExpressionError as problem:
+            raise RuntimeFault(f"The output {key!r} of {task} failed: {problem}") from None
+    return updated
+
+
+def resolve(task: str, value: Any, data: Mapping[str, Any]) -> Any:
+    """A configuration value with its expressions evaluated over the case data."""
+    try:
+        return expressions.resolve(value, {"data": data})
+    except expressions.ExpressionError as problem:
+        raise RuntimeFault(f"The configuration of {task} failed: {problem}") from None
+
+
+def correlates(message: MessageConfig, data: Mapping[str, Any], keys: Mapping[str, Any]) -> bool:
+    """Whether a message with correlation `keys` is the one a case with `data` waits for."""
+    if set(keys) != set(message.correlation):
+        return False
+    for key, text in message.correlation.items():
+        try:
+            if expressions.evaluate(text, {"data": data}) != keys[key]:
+                return False
+        except expressions.ExpressionError:
+            return False
+    return True

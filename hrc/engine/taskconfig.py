@@ -1,0 +1,268 @@
+"""What each task does when a case runs it: the `task` key of a transition, and guards and messages.
+
+A transition of an `hrc-pattern/1` document may carry, beside the formal model:
+
+- `"task"` on a task (a transition with a performer):
+  - operator tasks: `instructions` (text), `form` (a JSON Schema object the
+    completion's data must satisfy);
+  - cobot tasks, either a program step
+    `"step": {"program": "Coexistence_PickAndPlace", "number": 2, "workspace": 0, "poses": [[x, y, z, rx, ry, rz]]}`
+    or a device call `"device": {"call": "part-detection.scan", "args": {}}`;
+    a cobot task with neither runs step 1 of its actor's program (the actor's
+    `"program"` key, else DEFAULT_PROGRAM);
+  - any task: `outputs` (`{"case key": "expression over result and data"}`;
+    without it the whole result is stored under the task's id), `timeout`
+    (seconds) and `retries` (automatic retries of a cobot or device task).
+- `"guard"` on a silent transition: an expression over `data`; a silent
+  transition fires at once only when its guard holds.
+- `"message"` on a silent transition: `{"name": "...", "correlation": {"key": "expression"}}`;
+  it fires when a matching message arrives (POST /api/messages/), never by itself.
+
+Configuration values are literals or expressions (a string starting with "=",
+see expressions.py), resolved against the case data when the task starts.
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, Final, Literal
+
+from hrc.engine import expressions
+from hrc.engine.issues import Issue, error
+from hrc.engine.model import Pattern, Transition
+
+TaskKind = Literal["operator", "step", "device"]
+
+DEFAULT_PROGRAM: Final = "Coexistence_PickAndPlace"  # its step 1 moves home: harmless anywhere
+DEFAULT_TIMEOUT: Final = 120.0
+DEFAULT_RETRIES: Final = 3
+POSE_LENGTH: Final = 6
+MAX_POSES: Final = 2  # Double24–35 hold two poses
+
+# Device calls an automated task can make: the gateway method under Devices/,
+# its arguments in order, and the names its outputs get in the result.
+DEVICE_CALLS: Final[Mapping[str, tuple[str, tuple[str, ...], tuple[str, ...]]]] = {
+    "linear-axis.move": ("Devices/LinearAxis/Move", ("direction", "duration_ms"), ()),
+    "part-detection.scan": ("Devices/PartDetection/Scan", (), ("detected", "pose")),
+    "inspection.inspect": ("Devices/Inspection/Inspect", ("spot",), ("result",)),
+    "display.show": ("Devices/Display/Show", ("text",), ()),
+}
+
+# Names expressions may use: case data everywhere, a task's result in its outputs.
+DATA_NAMES: Final = frozenset({"data"})
+OUTPUT_NAMES: Final = frozenset({"data", "result"})
+
+
+@dataclass(frozen=True)
+class StepConfig:
+    program: str
+    number: Any
+    workspace: Any = 0
+    poses: Any = ()
+
+
+@dataclass(frozen=True)
+class DeviceConfig:
+    call: str
+    args: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def method(self) -> str:
+        return DEVICE_CALLS[self.call][0]
+
+    @property
+    def argument_names(self) -> tuple[str, ...]:
+        return DEVICE_CALLS[self.call][1]
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        return DEVICE_CALLS[self.call][2]
+
+
+@dataclass(frozen=True)
+class TaskConfig:
+    kind: TaskKind
+    instructions: str = ""
+    form: Mapping[str, Any] | None = None
+    step: StepConfig | None = None
+    device: DeviceConfig | None = None
+    outputs: Mapping[str, str] | None = None
+    timeout: float = DEFAULT_TIMEOUT
+    retries: int = DEFAULT_RETRIES
+
+
+class ConfigError(ValueError):
+    """A task, guard or message configuration is wrong; the message names the transition."""
+
+    def __init__(self, transition: str, message: str) -> None:
+        super().__init__(f"{transition}: {message}")
+        self.transition = transition
+
+
+def task_config(pattern: Pattern, transition: Transition) -> TaskConfig:
+    """The configuration of a task; raises ConfigError when it is malformed."""
+    raw = transition.extra.get("task", {})
+    t = transition.id
+    if not isinstance(raw, Mapping):
+        raise ConfigError(t, "'task' must be an object.")
+    actor = pattern.actor(transition.performer or "")
+    common = _common(t, raw)
+    if actor is None or actor.type == "operator":
+        form = raw.get("form")
+        if form is not None and (not isinstance(form, Mapping) or form.get("type") != "object"):
+            raise ConfigError(t, '\'form\' must be a JSON Schema object with "type": "object".')
+        for key in ("step", "device"):
+            if key in raw:
+                raise ConfigError(t, f"an operator task has no '{key}'; only cobot tasks do.")
+        return TaskConfig("operator", form=form, **common)
+    if "step" in raw and "device" in raw:
+        raise ConfigError(t, "a cobot task runs either a 'step' or a 'device' call, not both.")
+    if "device" in raw:
+        return TaskConfig("device", device=_device(t, raw["device"]), **common)
+    default_program = actor.extra.get("program", DEFAULT_PROGRAM)
+    return TaskConfig("step", step=_step(t, raw.get("step", {}), default_program), **common)
+
+
+def _common(t: str, raw: Mapping[str, Any]) -> dict[str, Any]:
+    instructions = raw.get("instructions", "")
+    if not isinstance(instructions, str):
+        raise ConfigError(t, "'instructions' must be text.")
+    outputs = raw.get("outputs")
+    if outputs is not None:
+        if not isinstance(outputs, Mapping) or not all(
+            isinstance(v, str) for v in outputs.values()
+        ):
+            raise ConfigError(t, "'outputs' must map case data keys to expressions.")
+        for key, text in outputs.items():
+            _check_expression(t, f"output {key!r}", text, OUTPUT_NAMES)
+    timeout = raw.get("timeout", DEFAULT_TIMEOUT)
+    if (
+        isinstance(timeout, bool)
+        or not isinstance(timeout, int | float)
+        or not 0 < timeout <= 86_400
+    ):
+        raise ConfigError(t, "'timeout' must be a number of seconds between 0 and 86400.")
+    retries = raw.get("retries", DEFAULT_RETRIES)
+    if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 20:
+        raise ConfigError(t, "'retries' must be a whole number from 0 to 20.")
+    return {
+        "instructions": instructions,
+        "outputs": outputs,
+        "timeout": float(timeout),
+        "retries": retries,
+    }
+
+
+def _step(t: str, raw: object, default_program: object) -> StepConfig:
+    if not isinstance(raw, Mapping):
+        raise ConfigError(t, "'step' must be an object.")
+    program = raw.get("program", default_program)
+    if not isinstance(program, str) or not program:
+        raise ConfigError(t, "the step's 'program' must be a program name.")
+    number = raw.get("number", 1)
+    workspace = raw.get("workspace", 0)
+    poses = raw.get("poses", [])
+    for name, value in (("number", number), ("workspace", workspace)):
+        if not expressions.is_expression(value) and (
+            isinstance(value, bool) or not isinstance(value, int)
+        ):
+            raise ConfigError(t, f"the step's '{name}' must be a whole number or an expression.")
+        _check_value(t, f"step {name}", value)
+    if expressions.is_expression(poses):
+        _check_value(t, "step poses", poses)
+    elif not isinstance(poses, list) or len(poses) > MAX_POSES:
+        raise ConfigError(t, f"the step's 'poses' must be a list of at most {MAX_POSES} poses.")
+    else:
+        for pose in poses:
+            _check_pose(t, pose)
+    return StepConfig(program, number, workspace, poses)
+
+
+def _check_pose(t: str, pose: object) -> None:
+    if expressions.is_expression(pose):
+        _check_value(t, "a pose", pose)
+        return
+    if not isinstance(pose, list) or len(pose) != POSE_LENGTH:
+        raise ConfigError(t, f"each pose is a list of {POSE_LENGTH} numbers (x, y, z, rx, ry, rz).")
+    for value in pose:
+        if expressions.is_expression(value):
+            _check_value(t, "a pose value", value)
+        elif isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(t, f"pose values are numbers, not {value!r}.")
+
+
+def _device(t: str, raw: object) -> DeviceConfig:
+    if not isinstance(raw, Mapping) or raw.get("call") not in DEVICE_CALLS:
+        raise ConfigError(t, f"'device' needs a 'call', one of {', '.join(DEVICE_CALLS)}.")
+    call = str(raw["call"])
+    args = raw.get("args", {})
+    expected = DEVICE_CALLS[call][1]
+    if not isinstance(args, Mapping) or set(args) != set(expected):
+        wanted = ", ".join(expected) or "none"
+        raise ConfigError(t, f"the device call {call} takes the arguments: {wanted}.")
+    for name, value in args.items():
+        _check_value(t, f"argument {name!r}", value)
+    return DeviceConfig(call, args)
+
+
+def _check_value(t: str, what: str, value: object) -> None:
+    if expressions.is_expression(value):
+        _check_expression(t, what, str(value)[1:], DATA_NAMES)
+
+
+def _check_expression(t: str, what: str, text: str, names: frozenset[str]) -> None:
+    problem = expressions.check(text, names)
+    if problem is not None:
+        raise ConfigError(t, f"{what}: {problem}")
+
+
+@dataclass(frozen=True)
+class MessageConfig:
+    name: str
+    correlation: Mapping[str, str]
+
+
+def guard_of(transition: Transition) -> str | None:
+    """The guard expression of a silent transition, None when it has none."""
+    guard = transition.extra.get("guard")
+    if guard is None:
+        return None
+    if not isinstance(guard, str) or not guard.strip():
+        raise ConfigError(transition.id, "'guard' must be an expression.")
+    _check_expression(transition.id, "guard", guard, DATA_NAMES)
+    return guard
+
+
+def message_of(transition: Transition) -> MessageConfig | None:
+    """What message a silent transition waits for, None when it waits for none."""
+    raw = transition.extra.get("message")
+    if raw is None:
+        return None
+    t = transition.id
+    if not isinstance(raw, Mapping) or not isinstance(raw.get("name"), str) or not raw["name"]:
+        raise ConfigError(t, "'message' needs a 'name'.")
+    correlation = raw.get("correlation", {})
+    if not isinstance(correlation, Mapping) or not all(
+        isinstance(v, str) for v in correlation.values()
+    ):
+        raise ConfigError(t, "the message's 'correlation' maps keys to expressions over data.")
+    for key, text in correlation.items():
+        _check_expression(t, f"correlation {key!r}", text, DATA_NAMES)
+    return MessageConfig(raw["name"], correlation)
+
+
+def config_issues(pattern: Pattern) -> list[Issue]:
+    """Every malformed task, guard or message configuration, as `task-config` errors."""
+    issues = []
+    for _, transition in pattern.transitions():
+        try:
+            if transition.is_task:
+                for key in ("guard", "message"):
+                    if key in transition.extra:
+                        raise ConfigError(transition.id, f"only silent transitions have a '{key}'.")
+                task_config(pattern, transition)
+            else:
+                guard_of(transition)
+                message_of(transition)
+        except ConfigError as problem:
+            issues.append(error("task-config", str(problem), transition.id))
+    return issues
