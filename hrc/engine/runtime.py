@@ -152,6 +152,9 @@ class CaseNet:
 
     def receive(self, marking: Marking, transition: str) -> Marking:
         """Fires a message transition; raises NotEnabled when the case is not waiting for it."""
+        if transition not in self.messages:
+            # Otherwise any silent transition (guard unchecked) or task start would fire here.
+            raise NotEnabled(f"{transition} waits for no message.")
         return self._fire(marking, transition, f"the message of {transition}")
 
     # Tasks -------------------------------------------------------------------------

@@ -191,7 +191,12 @@ def _check_pose(t: str, pose: object) -> None:
 
 
 def _device(t: str, raw: object) -> DeviceConfig:
-    if not isinstance(raw, Mapping) or raw.get("call") not in DEVICE_CALLS:
+    # The isinstance check first: `in` on a dict raises TypeError for a list or object.
+    if (
+        not isinstance(raw, Mapping)
+        or not isinstance(raw.get("call"), str)
+        or raw["call"] not in DEVICE_CALLS
+    ):
         raise ConfigError(t, f"'device' needs a 'call', one of {', '.join(DEVICE_CALLS)}.")
     call = str(raw["call"])
     args = raw.get("args", {})
