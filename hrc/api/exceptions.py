@@ -1,9 +1,10 @@
 """One error format for the whole API: `{"detail": str, ...}` with a 4xx status.
 
-DRF already turns its own exceptions into 4xx; this adds the Django and engine
-ones a view can raise (a request body over the size limit, a model rule, a
-document that is not `hrc-pattern/1`) so that bad input never reaches the
-client as a 500 with a traceback. Field errors keep DRF's shape under `fields`.
+DRF already turns its own exceptions into 4xx; this adds the Django, engine and
+case-service ones a view can raise (a request body over the size limit, a model
+rule, a document that is not `hrc-pattern/1`, a CaseError with its status) so
+that bad input never reaches the client as a 500 with a traceback. Field
+errors keep DRF's shape under `fields`.
 """
 
 from typing import Any
@@ -15,6 +16,7 @@ from rest_framework import exceptions, status
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
+from hrc.cases.errors import CaseError
 from hrc.engine import FormatError
 
 
@@ -55,6 +57,8 @@ def exception_handler(exc: Exception, context: dict[str, Any]) -> Response | Non
         return Response({"detail": str(exc)}, status=status.HTTP_400_BAD_REQUEST)
     if isinstance(exc, FormatError):
         exc = document_rejected(exc)
+    if isinstance(exc, CaseError):  # Invalid 400, NotAllowed 403, Conflict 409
+        return Response({"detail": str(exc)}, status=exc.status)
     if isinstance(exc, Rejected):
         return Response(exc.payload, status=exc.status_code)
     if isinstance(exc, DjangoValidationError):
