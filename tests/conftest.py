@@ -11,10 +11,11 @@ from django.contrib.auth.models import User
 from django.test import Client
 from rest_framework.test import APIClient
 
+from hrc.cases.models import Case
 from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
-from hrc.patterns.models import PatternModel
+from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
 
 
@@ -105,3 +106,19 @@ def staff_client(db: None) -> Client:
     client = Client()
     client.force_login(superuser)
     return client
+
+
+@pytest.fixture
+def choice_version(organisation: Organisation, engineer: User) -> PatternVersion:
+    """A published operator-only pattern: count (with a form), then fix or rework."""
+    return factories.make_version(
+        organisation, published_by=engineer, draft=factories.choice_document()
+    )
+
+
+@pytest.fixture
+def choice_case(choice_version: PatternVersion, engineer: User, operator: User) -> Case:
+    """A running case of choice_version whose tasks are offered to the operator alone."""
+    return factories.make_case(
+        choice_version, started_by=engineer, actor_mapping={"o": {"users": [operator.pk]}}
+    )

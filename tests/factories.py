@@ -1,4 +1,4 @@
-"""Test data in one place: people, organisations, cobots, patterns and pattern documents.
+"""Test data in one place: people, organisations, cobots, patterns, pattern documents, cases.
 
 Plain functions (no factory library): each makes a valid object with unique
 names unless told otherwise, through the services where a service exists.
@@ -9,7 +9,11 @@ import itertools
 from typing import Any
 
 from django.contrib.auth.models import User
+from django.db import transaction
 
+from hrc.cases import services as case_services
+from hrc.cases.choices import OPEN_WORK_ITEM_STATES, IncidentKind
+from hrc.cases.models import Case, Incident, WorkItem
 from hrc.cobots import services as cobot_services
 from hrc.cobots.choices import DriverKind
 from hrc.cobots.models import Cobot
@@ -17,7 +21,7 @@ from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.patterns import services as pattern_services
-from hrc.patterns.models import PatternModel
+from hrc.patterns.models import PatternModel, PatternVersion
 
 _serial = itertools.count(1)
 
@@ -108,3 +112,111 @@ def unsound_document() -> dict[str, Any]:
     document = valid_document()
     document["constraints"] = [{"from": "tc1", "to": "to1", "type": "time"}]
     return document
+
+
+# Running cases ---------------------------------------------------------------------------
+
+COUNT_FORM: dict[str, Any] = {
+    "type": "object",
+    "required": ["count"],
+    "properties": {"count": {"type": "integer", "minimum": 1}},
+}
+
+
+def _operator_net(
+    transitions: list[dict[str, Any]], arcs: list[list[str]], places: int
+) -> dict[str, Any]:
+    return {
+        "format": "hrc-pattern/1",
+        "name": "Operators only",
+        "actors": [{"id": "o", "type": "operator"}],
+        "processes": [
+            {
+                "id": "N",
+                "workpiece": "w",
+                "actors": ["o"],
+                "places": [{"id": "p1", "tokens": 1}]
+                + [{"id": f"p{n}"} for n in range(2, places + 1)],
+                "transitions": transitions,
+                "arcs": arcs,
+            }
+        ],
+        "constraints": [],
+    }
+
+
+def _chain(*nodes: str) -> list[list[str]]:
+    """Arcs along a path: _chain("p1", "t", "p2") is [["p1", "t"], ["t", "p2"]]."""
+    return [[a, b] for a, b in itertools.pairwise(nodes)]
+
+
+def choice_document() -> dict[str, Any]:
+    """Operators only, so no cobot is needed: count the parts (a form), then fix them by hand
+    or send them to rework: a deferred choice, whoever starts first decides."""
+    return _operator_net(
+        [
+            {
+                "id": "count",
+                "performer": "o",
+                "label": "count parts",
+                "task": {"instructions": "Count the parts on the tray.", "form": COUNT_FORM},
+            },
+            {"id": "fix", "performer": "o", "label": "fix by hand"},
+            {"id": "rework", "performer": "o", "label": "send to rework"},
+        ],
+        _chain("p1", "count", "p2", "fix", "p3") + _chain("p2", "rework", "p3"),
+        places=3,
+    )
+
+
+def message_document() -> dict[str, Any]:
+    """Operators only: prepare the order, wait for the message `part-ready` about this case's
+    order (correlation key `order` = data.order), then assemble."""
+    return _operator_net(
+        [
+            {"id": "prepare", "performer": "o", "label": "prepare order"},
+            {
+                "id": "arrive",
+                "message": {"name": "part-ready", "correlation": {"order": "data.order"}},
+            },
+            {"id": "assemble", "performer": "o", "label": "assemble"},
+        ],
+        _chain("p1", "prepare", "p2", "arrive", "p3", "assemble", "p4"),
+        places=4,
+    )
+
+
+def make_version(
+    organisation: Organisation, *, published_by: User, draft: object = None
+) -> PatternVersion:
+    """A published version (of valid_document() unless told otherwise)."""
+    pattern = make_pattern(organisation, draft=draft, created_by=published_by)
+    return pattern_services.publish_pattern(pattern, published_by=published_by)
+
+
+def make_case(
+    version: PatternVersion,
+    *,
+    started_by: User,
+    actor_mapping: dict[str, Any],
+    data: dict[str, Any] | None = None,
+) -> Case:
+    return case_services.start_case(
+        version, started_by=started_by, actor_mapping=actor_mapping, data=data
+    )
+
+
+def open_work_item(case: Case, task: str) -> WorkItem:
+    """The case's open work item for the task; fails when there is none."""
+    return WorkItem.objects.get(case=case, task=task, state__in=sorted(OPEN_WORK_ITEM_STATES))
+
+
+def make_incident(item: WorkItem, message: str = "The step failed.") -> Incident:
+    """An open incident about a work item, as a worker opens one (holding the case row lock)."""
+    with transaction.atomic():
+        case = Case.objects.select_for_update().get(pk=item.case_id)
+        incident = case_services.open_incident(
+            case, IncidentKind.STEP_FAILED, message, item=item, cobot_state={"RobotMode": 7}
+        )
+        case.save()
+    return incident

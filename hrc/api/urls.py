@@ -6,4 +6,5 @@ urlpatterns = [
     path("", include("hrc.organisations.api.urls")),
     path("", include("hrc.patterns.api.urls")),
     path("", include("hrc.cobots.api.urls")),
+    path("", include("hrc.cases.api.urls")),
 ]

@@ -1,0 +1,155 @@
+"""Reads of cases, work items, jobs and incidents across the organisation wall.
+
+Every function starts from the user's organisations, so an outsider gets
+empty querysets (and the API 404s) whatever ids they try.
+"""
+
+from collections.abc import Iterable
+
+from django.db.models import Case as SqlCase
+from django.db.models import (
+    Count,
+    Exists,
+    IntegerField,
+    OuterRef,
+    Prefetch,
+    Q,
+    QuerySet,
+    Subquery,
+    Value,
+    When,
+)
+from django.db.models.functions import Coalesce
+
+from hrc.cases.choices import OPEN_WORK_ITEM_STATES, JobState, WorkItemKind, WorkItemState
+from hrc.cases.models import Case, CaseEvent, Incident, Job, WorkItem
+from hrc.organisations.models import Team
+from hrc.organisations.selectors import AnyUser, organisations_of
+
+# The jobs a cobot has still to do or is doing: its queue.
+QUEUE_STATES = (JobState.QUEUED, JobState.RUNNING)
+
+
+def cases_visible_to(user: AnyUser) -> QuerySet[Case]:
+    """The cases of the user's organisations, with their version and pattern."""
+    return Case.objects.filter(organisation__in=organisations_of(user)).select_related(
+        "version__pattern", "started_by"
+    )
+
+
+def with_open_work(cases: QuerySet[Case], user: AnyUser) -> QuerySet[Case]:
+    """The cases with `open_work_items` and `open_incidents` (lists) prefetched."""
+    open_items = work_items_visible_to(user).filter(state__in=OPEN_WORK_ITEM_STATES)
+    open_incidents = Incident.objects.filter(resolved_at__isnull=True).select_related("work_item")
+    return cases.prefetch_related(
+        Prefetch("work_items", open_items.order_by("offered_at", "id"), "open_work_items"),
+        Prefetch("incidents", open_incidents.order_by("opened_at", "id"), "open_incidents"),
+    )
+
+
+def events_of(case: Case, *, after: int | None = None) -> QuerySet[CaseEvent]:
+    """The case's log in order; only the events after sequence number `after` when given."""
+    events = CaseEvent.objects.filter(case=case).select_related("user").order_by("seq")
+    return events if after is None else events.filter(seq__gt=after)
+
+
+def work_items_visible_to(user: AnyUser) -> QuerySet[WorkItem]:
+    """Every work item, open or not, of the user's organisations' cases (read access)."""
+    return (
+        WorkItem.objects.filter(case__organisation__in=organisations_of(user))
+        .select_related("case__version", "claimed_by", "completed_by", "cobot", "job")
+        .annotate(queue_position=_queue_position("job__"))
+    )
+
+
+def performable_by(user: AnyUser) -> Q:
+    """Operator work items offered to `user`: as a candidate or as a member of the item's team.
+
+    Subqueries, not joins, so the rows stay one per item without DISTINCT; the
+    same rule as services.may_perform.
+    """
+    if not user.is_authenticated:
+        return Q(pk__in=[])
+    candidate = WorkItem.candidates.through.objects.filter(
+        workitem_id=OuterRef("pk"), user_id=user.pk
+    )
+    in_team = Team.members.through.objects.filter(
+        team_id=OuterRef("team_id"), membership__user_id=user.pk
+    )
+    return Q(kind=WorkItemKind.OPERATOR) & (Q(Exists(candidate)) | Q(Exists(in_team)))
+
+
+def task_list(user: AnyUser, kinds: Iterable[str] = (WorkItemKind.OPERATOR,)) -> QuerySet[WorkItem]:
+    """Open work items for the user's task list, in the order they were offered; one query.
+
+    Operator items: those the user may perform that nobody else holds (offered,
+    or claimed or started by the user). Cobot items (step, device): every open
+    one of the user's organisations, to follow read-only.
+    """
+    kinds = set(kinds)
+    wanted = Q(pk__in=[])
+    if WorkItemKind.OPERATOR in kinds:
+        mine = Q(state=WorkItemState.OFFERED) | Q(claimed_by_id=user.pk)
+        wanted |= performable_by(user) & mine
+    cobot_kinds = kinds & {WorkItemKind.STEP, WorkItemKind.DEVICE}
+    if cobot_kinds:
+        wanted |= Q(kind__in=sorted(cobot_kinds))
+    return (
+        work_items_visible_to(user)
+        .filter(wanted, state__in=OPEN_WORK_ITEM_STATES)
+        .order_by("offered_at", "id")
+    )
+
+
+def jobs_visible_to(user: AnyUser) -> QuerySet[Job]:
+    """Every job of the user's organisations' cases, with its `queue_position` annotated."""
+    return (
+        Job.objects.filter(case__organisation__in=organisations_of(user))
+        .select_related("work_item", "cobot")
+        .annotate(queue_position=_queue_position(""))
+    )
+
+
+def cobot_queues(user: AnyUser) -> QuerySet[Job]:
+    """Queued and running jobs in queue order: per cobot, the running one, then first come first served."""
+    running_first = SqlCase(When(state=JobState.RUNNING, then=Value(0)), default=Value(1))
+    return (
+        jobs_visible_to(user)
+        .filter(state__in=QUEUE_STATES)
+        .order_by("cobot_id", running_first, "queued_at", "id")
+    )
+
+
+def _queue_position(prefix: str) -> SqlCase:
+    """0 for the job on its cobot now, 1 for the next in line…; null once it has left the queue."""
+    return SqlCase(
+        When(**{f"{prefix}state": JobState.RUNNING}, then=Value(0)),
+        When(**{f"{prefix}state": JobState.QUEUED}, then=_queued_ahead(prefix) + 1),
+        default=None,
+        output_field=IntegerField(),
+    )
+
+
+def _queued_ahead(prefix: str) -> Coalesce:
+    """How many queued jobs of the same cobot came before the job at `prefix` (FCFS order)."""
+    earlier = Q(queued_at__lt=OuterRef(f"{prefix}queued_at")) | Q(
+        queued_at=OuterRef(f"{prefix}queued_at"), pk__lt=OuterRef(f"{prefix}pk")
+    )
+    ahead = (
+        Job.objects.filter(earlier, cobot_id=OuterRef(f"{prefix}cobot_id"), state=JobState.QUEUED)
+        .order_by()
+        .values("cobot_id")
+        .annotate(n=Count("pk"))
+        .values("n")
+    )
+    return Coalesce(Subquery(ahead), Value(0))
+
+
+def incidents_visible_to(user: AnyUser, *, open_only: bool = True) -> QuerySet[Incident]:
+    """Incidents of the user's organisations' cases, newest first; only unresolved by default."""
+    incidents = Incident.objects.filter(case__organisation__in=organisations_of(user))
+    if open_only:
+        incidents = incidents.filter(resolved_at__isnull=True)
+    return incidents.select_related("case", "work_item", "resolved_by").order_by(
+        "-opened_at", "-id"
+    )
