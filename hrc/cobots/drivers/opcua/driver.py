@@ -46,6 +46,8 @@ from hrc.cobots.pki import PkiError, check_gateway_certificate, secure_client
 
 logger = logging.getLogger(__name__)
 
+SESSION_TIMEOUT_MS = 600_000
+
 IN_BIT = urua.register_path("Inputs", urua.HANDSHAKE_BIT)
 IN_FENCE = (
     urua.register_path("Inputs", urua.FENCE_STEP),
@@ -189,6 +191,9 @@ class OpcUaDriver(CobotDriver):
     async def _open(self, deadline: float) -> None:
         await self.close()
         client = Client(self.endpoint, timeout=self.request_timeout)
+        # asyncua asks for an hour and warns when the server grants less; ours grants ten minutes,
+        # and the session is kept alive by its subscription anyway.
+        client.session_timeout = SESSION_TIMEOUT_MS
         client.name = client.description = f"hrc driver for {self.name}"
         if self.security is not None:
             try:

@@ -1,0 +1,81 @@
+"""`python manage.py run_pattern FILE [--cases N] --simulate [--time-scale F] --json`
+
+Runs a pattern file end to end against simulated cobots (one OPC UA gateway
+process per cobot actor) with operators that complete their tasks by
+themselves, and prints one JSON event per line:
+{"seq", "at", "case", "task", "actor", "event"}. Exits 0 when every case completed.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from django.core.management.base import BaseCommand, CommandError, CommandParser
+
+from hrc.cases.simulation import Simulation
+from hrc.engine.check import check_document
+from hrc.engine.document import FormatError, parse_json
+
+
+class Command(BaseCommand):
+    help = "Runs a pattern's cases against simulated cobots and prints what happened."
+
+    def add_arguments(self, parser: CommandParser) -> None:
+        parser.add_argument("file", type=Path, help="An hrc-pattern/1 document.")
+        parser.add_argument("--cases", type=int, default=1, help="How many cases to run.")
+        parser.add_argument(
+            "--simulate", action="store_true", required=True,
+            help="Simulated cobots and operators (the only mode: real ones run from the tablets).",
+        )  # fmt: skip
+        parser.add_argument(
+            "--time-scale", type=float, default=0.05,
+            help="Simulated time per real second: 0.05 runs twenty times faster, 0 takes no time.",
+        )  # fmt: skip
+        parser.add_argument("--json", action="store_true", help="One JSON event per line.")
+        parser.add_argument("--timeout", type=float, default=600.0, help="Give up after (s).")
+        parser.add_argument(
+            "--workers", choices=("inline", "celery"), default="inline",
+            help="inline: jobs run on threads here; celery: on workers started separately.",
+        )  # fmt: skip
+        parser.add_argument("--seed", type=int, default=None, help="Operators' random delays.")
+
+    def handle(self, *args: Any, **options: Any) -> None:
+        document = self._read(options["file"])
+        if options["cases"] < 1:
+            raise CommandError("--cases must be 1 or more.")
+        if options["time_scale"] < 0:
+            raise CommandError("--time-scale must be 0 or more.")
+        with tempfile.TemporaryDirectory(prefix="hrc-run-pattern-") as workdir, Simulation(
+            document, Path(workdir), time_scale=options["time_scale"],
+            inline=options["workers"] == "inline", seed=options["seed"],
+        ) as simulation:  # fmt: skip
+            events = simulation.run(options["cases"], timeout=options["timeout"])
+        for event in events:
+            if options["json"]:
+                self.stdout.write(json.dumps(event.as_dict()))
+            else:
+                self.stdout.write(
+                    f"{event.seq:5} {event.at} case {event.case} "
+                    f"{event.event} {event.task or ''} {event.actor or ''}".rstrip()
+                )
+        failed = sorted({e.case for e in events if e.event == "case-failed"})
+        if failed:
+            raise CommandError(f"{len(failed)} case(s) did not complete: {failed}")
+
+    def _read(self, path: Path) -> dict[str, Any]:
+        try:
+            text = path.read_bytes()
+        except OSError as error:
+            raise CommandError(f"Cannot read {path}: {error.strerror}.") from None
+        try:
+            data = parse_json(text)
+        except FormatError as error:
+            raise CommandError(f"{path}: {error}") from None
+        report = check_document(data)
+        if not report.valid or not isinstance(data, dict):
+            problems = "; ".join(f"{issue.code}: {issue.message}" for issue in report.errors)
+            raise CommandError(f"{path} cannot run: {problems}")
+        return data

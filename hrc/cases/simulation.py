@@ -1,0 +1,294 @@
+"""Running a pattern against simulated cobots, with operators who complete their tasks by themselves.
+
+What `manage.py run_pattern --simulate` does, kept here so tests and the
+benchmark drive the very same thing: a scratch organisation with one user per
+operator actor and one simulated gateway (a real OPC UA server process) per
+cobot actor; the pattern published there; N cases started; every operator
+task started as soon as it is offered and completed after a short random
+delay. Jobs run either on this process's threads (`inline`) or on Celery
+workers started elsewhere.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import random
+import threading
+import time
+import uuid
+from collections.abc import Iterator, Mapping
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from django.contrib.auth.models import User
+from django.db import close_old_connections
+from django.utils import timezone
+
+from hrc.cases import dispatch, jobs, services
+from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus, WorkItemKind, WorkItemState
+from hrc.cases.errors import CaseError
+from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
+from hrc.cases.nets import case_net
+from hrc.cobots.drivers.runner import driver_for
+from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.models import Cobot
+from hrc.engine.model import Pattern
+from hrc.engine.taskconfig import DEFAULT_PROGRAM
+from hrc.organisations.choices import Role
+from hrc.organisations.models import Membership, Organisation
+from hrc.patterns import services as pattern_services
+from hrc.patterns.models import PatternVersion
+
+# The events a run reports, as issue #4's run_pattern contract names them.
+REPORTED = {
+    "task-started",
+    "task-completed",
+    "task-interrupted",
+    "task-resumed",
+    "case-completed",
+}
+FAILED = {"case-failed", "case-cancelled"}
+
+
+@dataclass
+class RunEvent:
+    seq: int
+    at: str
+    case: int
+    task: str | None
+    actor: str | None
+    event: str
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "seq": self.seq,
+            "at": self.at,
+            "case": self.case,
+            "task": self.task,
+            "actor": self.actor,
+            "event": self.event,
+        }
+
+
+@dataclass
+class Simulation:
+    """One run: set up, run cases, report; use as a context manager so gateways stop."""
+
+    document: Mapping[str, Any]
+    workdir: Path
+    time_scale: float = 0.05
+    operator_delay: tuple[float, float] = (0.2, 1.0)  # seconds, times time_scale
+    inline: bool = True
+    seed: int | None = None
+    organisation: Organisation = field(init=False)
+    version: PatternVersion = field(init=False)
+    gateways: dict[str, GatewayProcess] = field(default_factory=dict, init=False)
+    users: dict[str, User] = field(default_factory=dict, init=False)
+
+    def __post_init__(self) -> None:
+        self._random = random.Random(self.seed)
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+        self._pool: ThreadPoolExecutor | None = None
+        self._cobot_names: dict[str, str] = {}
+
+    # Set-up ---------------------------------------------------------------------------
+
+    def __enter__(self) -> Simulation:
+        try:
+            self._set_up()
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _set_up(self) -> None:
+        suffix = uuid.uuid4().hex[:8]
+        self.organisation = Organisation.objects.create(
+            name=f"run_pattern {suffix}", slug=f"run-pattern-{suffix}"
+        )
+        engineer = self._member(f"rp-{suffix}-engineer", Role.ENGINEER)
+        pattern = pattern_services.create_pattern(
+            self.organisation,
+            name=str(self.document.get("name") or "pattern"),
+            created_by=engineer,
+            draft=dict(self.document),
+        )
+        self.version = pattern_services.publish_pattern(pattern, published_by=engineer)
+        net = case_net(self.version)
+        mapping: dict[str, Any] = {}
+        for actor in net.pattern.actors:
+            if actor.type == "operator":
+                self.users[actor.id] = self._member(f"rp-{suffix}-{actor.id}", Role.OPERATOR)
+                mapping[actor.id] = {"users": [self.users[actor.id].pk]}
+            else:
+                mapping[actor.id] = {"cobot": self._simulated_cobot(actor.id, net.pattern).pk}
+        services.set_default_actor_mapping(self.version, mapping)
+
+    def _member(self, username: str, role: str) -> User:
+        user = User.objects.create_user(username)
+        Membership.objects.create(user=user, organisation=self.organisation, role=role)
+        return user
+
+    def _simulated_cobot(self, actor: str, pattern: Pattern) -> Cobot:
+        name = f"{actor}-{self.organisation.slug}"
+        gateway = GatewayProcess(name, self.workdir / f"{name}.json", time_scale=self.time_scale)
+        self.gateways[actor] = gateway.start()
+        self._cobot_names[actor] = name
+        program = _program_of(pattern, actor)
+        driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
+        driver.call("PowerOn", timeout=30)
+        driver.call("SelectProgram", program)
+        driver.call("StartProgram")
+        return Cobot.objects.create(
+            organisation=self.organisation, name=name, endpoint=gateway.endpoint
+        )
+
+    def close(self) -> None:
+        self._stop.set()
+        for thread in self._threads:
+            thread.join(10)
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+        for actor, gateway in self.gateways.items():
+            # The sessions first: a gateway gone under an open session makes noise in the log.
+            with contextlib.suppress(Exception):
+                driver_for(self._cobot_names[actor], gateway.endpoint).close()
+            gateway.stop()
+
+    # Running --------------------------------------------------------------------------
+
+    def run(self, cases: int, timeout: float = 600.0) -> list[RunEvent]:
+        """Starts `cases` cases and waits until each has ended; returns the run's events."""
+        with self._workers():
+            started = [services.start_case(self.version, started_by=None).pk for _ in range(cases)]
+            self._wait(started, timeout)
+        return self.events(started)
+
+    @contextlib.contextmanager
+    def _workers(self) -> Iterator[None]:
+        self._spawn(self._operators)
+        if not self.inline:
+            yield
+            return
+        self._pool = ThreadPoolExecutor(max_workers=len(self.gateways) + 2)
+        self._spawn(self._sweeper)
+        with dispatch.run_inline(self._pool):
+            yield
+
+    def _spawn(self, target: Any) -> None:
+        thread = threading.Thread(target=target, daemon=True)
+        thread.start()
+        self._threads.append(thread)
+
+    def _wait(self, case_ids: list[int], timeout: float) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            still_open = Case.objects.filter(pk__in=case_ids, status__in=OPEN_CASE_STATUSES)
+            stuck = Incident.objects.filter(case__in=still_open, resolved_at__isnull=True)
+            if not still_open.exclude(pk__in=stuck.values("case_id")).exists():
+                return
+            time.sleep(0.05)
+
+    def _sweeper(self) -> None:
+        while not self._stop.wait(0.5):
+            try:
+                jobs.sweep()
+            finally:
+                close_old_connections()
+
+    def _operators(self) -> None:
+        """Every operator starts an offered task at once and completes it after a short delay."""
+        due: dict[int, float] = {}
+        users = {user.pk: user for user in self.users.values()}
+        while not self._stop.wait(0.01):
+            try:
+                self._operate(due, users)
+            finally:
+                close_old_connections()
+
+    def _operate(self, due: dict[int, float], users: dict[int, User]) -> None:
+        items = WorkItem.objects.filter(
+            case__organisation=self.organisation,
+            kind=WorkItemKind.OPERATOR,
+            state__in=[WorkItemState.OFFERED, WorkItemState.RUNNING],
+            case__status=CaseStatus.RUNNING,
+        ).prefetch_related("candidates")
+        now = time.monotonic()
+        for item in items:
+            user = next((users[c.pk] for c in item.candidates.all() if c.pk in users), None)
+            if user is None:
+                continue
+            with contextlib.suppress(CaseError):  # withdrawn or held meanwhile: try again later
+                if item.state == WorkItemState.OFFERED:
+                    services.start_work_item(item, user=user)
+                    low, high = self.operator_delay
+                    due[item.pk] = now + self._random.uniform(low, high) * self.time_scale
+                elif now >= due.setdefault(item.pk, now):
+                    form = case_net(item.case.version).tasks[item.task].form
+                    services.complete_work_item(item, user=user, data=example_for(form))
+
+    # Reporting ------------------------------------------------------------------------
+
+    def events(self, case_ids: list[int]) -> list[RunEvent]:
+        """The run's events in time order, numbered; an unfinished case gets case-failed."""
+        rows = CaseEvent.objects.filter(case_id__in=case_ids).order_by("at", "case_id", "seq")
+        ended: set[int] = set()
+        events: list[tuple[dt.datetime, int, str | None, str | None, str]] = []
+        for row in rows.values_list("at", "case_id", "task", "actor", "type"):
+            at, case, task, actor, kind = row
+            if kind in FAILED:
+                kind = "case-failed"
+            if kind not in REPORTED and kind != "case-failed":
+                continue
+            if kind.startswith("case-"):
+                ended.add(case)
+                task = actor = None
+            events.append((at, case, task or None, actor or None, kind))
+        for case in case_ids:
+            if case not in ended:
+                events.append((timezone.now(), case, None, None, "case-failed"))
+        return [
+            RunEvent(seq, at.isoformat(), case, task, actor, kind)
+            for seq, (at, case, task, actor, kind) in enumerate(events, start=1)
+        ]
+
+
+def _program_of(pattern: Pattern, actor: str) -> str:
+    found = pattern.actor(actor)
+    program = found.extra.get("program") if found else None
+    return program if isinstance(program, str) and program else DEFAULT_PROGRAM
+
+
+def example_for(schema: Mapping[str, Any] | None) -> dict[str, Any]:
+    """Form data a simulated operator enters: a value of the right type for each required field."""
+    if not schema:
+        return {}
+    values: dict[str, Any] = {}
+    properties = schema.get("properties", {})
+    for name in schema.get("required", []):
+        values[name] = _example_value(properties.get(name, {}))
+    return values
+
+
+def _example_value(schema: Mapping[str, Any]) -> Any:
+    if "enum" in schema:
+        return schema["enum"][0]
+    if "default" in schema:
+        return schema["default"]
+    kind = schema.get("type")
+    if kind == "boolean":
+        return True
+    if kind in ("integer", "number"):
+        return schema.get("minimum", 0)
+    if kind == "array":
+        return []
+    if kind == "object":
+        return example_for(schema)
+    return "ok"
