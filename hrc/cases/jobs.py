@@ -112,8 +112,8 @@ def lease_next_job(cobot_id: int) -> Lease | None:
 
 
 def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -> Lease | None:
-    case = Case.objects.select_for_update().select_related("version").get(pk=case_id)
-    job = Job.objects.select_for_update().select_related("work_item").get(pk=job_id)
+    case = services.lock_case(case_id)
+    job = Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
@@ -279,8 +279,10 @@ def _backoff(retries_used: int) -> float:
 def _locked_job(lease: Lease) -> tuple[Case, Job | None]:
     """The case (locked) and the job, or None when this worker's lease is no longer the job's."""
     case_id = Job.objects.values_list("case_id", flat=True).get(pk=lease.job_id)
-    case = Case.objects.select_for_update().select_related("version").get(pk=case_id)
-    job = Job.objects.select_for_update().select_related("work_item").get(pk=lease.job_id)
+    case = services.lock_case(case_id)
+    job = (
+        Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=lease.job_id)
+    )
     if job.state != JobState.RUNNING or job.lease != lease.lease:
         logger.info("Job %s: lease %s was lost; its outcome is dropped", job.pk, lease.lease)
         return case, None
@@ -340,8 +342,8 @@ def _first_due_per_cobot(now: dt.datetime) -> list[int]:
 
 def _expire_lease(job_id: int, case_id: int) -> None:
     with transaction.atomic():
-        case = Case.objects.select_for_update().get(pk=case_id)
-        job = Job.objects.select_for_update().select_related("work_item").get(pk=job_id)
+        case = services.lock_case(case_id)
+        job = Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=job_id)
         if (
             job.state != JobState.RUNNING
             or job.lease_expires_at is None
@@ -372,7 +374,9 @@ def interrupt_cobot(interruption_id: int) -> None:
     """Pauses (or slows) the cobot for an interruption still open; never twice."""
     with transaction.atomic():
         interruption = (
-            Interruption.objects.select_for_update().select_related("cobot").get(pk=interruption_id)
+            Interruption.objects.select_for_update(of=("self",))
+            .select_related("cobot")
+            .get(pk=interruption_id)
         )
         if interruption.ended_at is not None or interruption.paused_at is not None:
             return
@@ -394,7 +398,9 @@ def resume_cobot(interruption_id: int) -> None:
     """Resumes the cobot after an interruption that paused it, when no other keeps it paused."""
     with transaction.atomic():
         interruption = (
-            Interruption.objects.select_for_update().select_related("cobot").get(pk=interruption_id)
+            Interruption.objects.select_for_update(of=("self",))
+            .select_related("cobot")
+            .get(pk=interruption_id)
         )
         if interruption.ended_at is None or interruption.resumed_at is not None:
             return

@@ -72,7 +72,7 @@ def _deliver(message: Message) -> None:
     ).values_list("pk", flat=True)
     for case_id in candidates:
         with transaction.atomic():
-            case = Case.objects.select_for_update().select_related("version").get(pk=case_id)
+            case = services.lock_case(case_id)
             if case.status != CaseStatus.RUNNING:
                 continue
             net = case_net(case.version)

@@ -78,7 +78,7 @@ def start_case(
             actor_mapping=mapping,
             started_by=started_by,
         )
-        case = Case.objects.select_for_update().get(pk=case.pk)
+        case = lock_case(case.pk)
         record_event(case, EventType.CASE_STARTED, user=started_by, after=net.initial)
         advance(case, net)
         case.save()
@@ -107,7 +107,7 @@ def cancel_case(case: Case, *, by: User | None, reason: str = "") -> Case:
     this); its result is then ignored. Raises Conflict when the case has ended.
     """
     with transaction.atomic():
-        case = _locked(case.pk)
+        case = lock_case(case.pk)
         _check_open(case)
         _end(case, CaseStatus.CANCELLED, EventType.CASE_CANCELLED, by, {"reason": reason})
         case.save()
@@ -117,7 +117,7 @@ def cancel_case(case: Case, *, by: User | None, reason: str = "") -> Case:
 def suspend_case(case: Case, *, by: User | None) -> Case:
     """Stops offering and dispatching new work; tasks already running may finish."""
     with transaction.atomic():
-        case = _locked(case.pk)
+        case = lock_case(case.pk)
         if case.status != CaseStatus.RUNNING:
             raise Conflict(f"Case {case.pk} is {case.status}, not running: it cannot be suspended.")
         case.status = CaseStatus.SUSPENDED
@@ -128,7 +128,7 @@ def suspend_case(case: Case, *, by: User | None) -> Case:
 
 def resume_case(case: Case, *, by: User | None) -> Case:
     with transaction.atomic():
-        case = _locked(case.pk)
+        case = lock_case(case.pk)
         if case.status != CaseStatus.SUSPENDED:
             raise Conflict(f"Case {case.pk} is {case.status}, not suspended.")
         case.status = CaseStatus.RUNNING
@@ -283,7 +283,7 @@ def resolve_incident(
             f"resolution must be one of {', '.join(Resolution.values)}, not {resolution!r}."
         )
     with transaction.atomic():
-        case = _locked(incident.case_id)
+        case = lock_case(incident.case_id)
         incident = Incident.objects.select_for_update().get(pk=incident.pk)
         if incident.resolved_at is not None:
             raise Conflict(f"Incident {incident.pk} was resolved already ({incident.resolution}).")
@@ -616,13 +616,14 @@ def _fail(case: Case, message: str) -> None:
     _end(case, CaseStatus.FAILED, EventType.CASE_FAILED, None, {"message": message})
 
 
-def _locked(case_id: int) -> Case:
-    return Case.objects.select_for_update().select_related("version").get(pk=case_id)
+def lock_case(case_id: int) -> Case:
+    """The case, its row locked until the transaction ends (its version read along, not locked)."""
+    return Case.objects.select_for_update(of=("self",)).select_related("version").get(pk=case_id)
 
 
 def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:
     """The case (locked) and a fresh copy of an operator work item the user may perform."""
-    case = _locked(item.case_id)
+    case = lock_case(item.case_id)
     item = WorkItem.objects.get(pk=item.pk)
     if item.kind != WorkItemKind.OPERATOR:
         raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
