@@ -72,7 +72,9 @@ def _steer(
             modeladmin.message_user(request, f"{done} case(s) {verb}.", messages.SUCCESS)
 
     steer.__name__ = f"{verb}_cases"
-    return admin.action(description=f"{verb.capitalize()} selected cases")(steer)
+    return admin.action(description=f"{verb.capitalize()} selected cases", permissions=["steer"])(
+        steer
+    )
 
 
 @admin.register(Case)
@@ -88,9 +90,9 @@ class CaseAdmin(ReadOnlyAdmin):
         _steer("resumed", lambda case, user: services.resume_case(case, by=user)),
     ]
 
-    def has_change_permission(self, request: HttpRequest, obj: Any = None) -> bool:
-        # The actions need it on the list; the change page still shows every field read-only.
-        return obj is None and super(ReadOnlyAdmin, self).has_change_permission(request, obj)
+    def has_steer_permission(self, request: HttpRequest) -> bool:
+        # Steering is a change to the case, made by its service, never by the form.
+        return request.user.has_perm("cases.change_case")
 
 
 @admin.register(WorkItem)
