@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import os
+import socket
 from dataclasses import dataclass
 from typing import Any
 
@@ -129,6 +131,7 @@ def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -
     if item.state == WorkItemState.OFFERED:
         services.start_cobot_task(case, net, item)
     job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
+    job.held_by = f"{socket.gethostname()}:{os.getpid()}"
     job.started_at = job.started_at or now
     job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
     job.save()

@@ -133,6 +133,9 @@ class Job(models.Model):
     lease = models.PositiveIntegerField(default=0)
     lease_expires_at = models.DateTimeField(null=True, blank=True)
     lease_expiries = models.PositiveIntegerField(default=0)
+    held_by = models.CharField(
+        max_length=100, blank=True, help_text="host:pid of the worker that holds the lease."
+    )
     retries_left = models.PositiveIntegerField(default=3)
     timeout = models.FloatField(help_text="Seconds the step or call may take.")
     queued_at = models.DateTimeField(auto_now_add=True, help_text="Its place in the cobot's queue.")

@@ -91,6 +91,8 @@ else:
     CHANNEL_LAYERS = {"default": {"BACKEND": "channels.layers.InMemoryChannelLayer"}}
     CELERY_BROKER_URL = "memory://"
     CELERY_TASK_ALWAYS_EAGER = True
+# Tests and the benchmark give each run its own queue on a shared broker.
+CELERY_TASK_DEFAULT_QUEUE = env_str("HRC_CELERY_QUEUE") or "celery"
 CELERY_TASK_ACKS_LATE = True
 CELERY_WORKER_PREFETCH_MULTIPLIER = 1
 # A request must not hang on a broker that is down: the row is the truth and
