@@ -87,8 +87,10 @@ class CaseViewSet(mixins.ListModelMixin, mixins.RetrieveModelMixin, viewsets.Gen
 
     def get_queryset(self) -> QuerySet[Case]:
         cases = selectors.cases_visible_to(self.request.user).order_by("-started_at", "-id")
-        if self.action != "list":
+        if self.action == "retrieve":
             return selectors.with_open_work(cases, self.request.user)
+        if self.action != "list":
+            return cases  # the actions answer with a fresh copy (_detail)
         wanted = self.request.query_params.get("status")
         if wanted is not None:
             if wanted not in CaseStatus.values:
