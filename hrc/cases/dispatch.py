@@ -19,7 +19,7 @@ from contextlib import contextmanager
 from typing import Any
 
 from django.conf import settings
-from django.db import close_old_connections, transaction
+from django.db import connections, transaction
 
 logger = logging.getLogger(__name__)
 
@@ -54,7 +54,8 @@ def _submit_inline(
         except Exception:
             logger.exception("Inline task failed")
         finally:
-            close_old_connections()
+            # A pool thread's connection would outlive the run (and block dropping the database).
+            connections.close_all()
 
     if countdown:
         timer = threading.Timer(countdown, lambda: executor.submit(call))

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from django.contrib.auth.models import User
-from django.db import close_old_connections
+from django.db import close_old_connections, connections
 from django.utils import timezone
 
 from hrc.cases import dispatch, jobs, services
@@ -150,6 +150,13 @@ class Simulation:
             organisation=self.organisation, name=name, endpoint=gateway.endpoint
         )
 
+    def executed_steps(self, actor: str) -> tuple[int, list[str]]:
+        """What the actor's simulated cobot counted: (executions, the tokens of the latest ones)."""
+        driver = driver_for(self._cobot_names[actor], self.gateways[actor].endpoint)
+        return int(driver.read("Simulator/Executions")), list(
+            driver.read("Simulator/ExecutedSteps")
+        )
+
     def close(self) -> None:
         self._stop.set()
         for thread in self._threads:
@@ -166,35 +173,48 @@ class Simulation:
 
     def run(self, cases: int, timeout: float = 600.0) -> list[RunEvent]:
         """Starts `cases` cases and waits until each has ended; returns the run's events."""
-        with self._workers():
-            started = [services.start_case(self.version, started_by=None).pk for _ in range(cases)]
-            self._wait(started, timeout)
+        with self.running():
+            started = self.start_cases(cases)
+            self.wait(started, timeout)
         return self.events(started)
 
+    def start_cases(self, count: int) -> list[int]:
+        return [services.start_case(self.version, started_by=None).pk for _ in range(count)]
+
     @contextlib.contextmanager
-    def _workers(self) -> Iterator[None]:
+    def running(self) -> Iterator[None]:
+        """Operators at work (and, inline, the jobs and the sweeper) while inside."""
+        self._stop.clear()
         self._spawn(self._operators)
-        if not self.inline:
-            yield
-            return
-        self._pool = ThreadPoolExecutor(max_workers=len(self.gateways) + 2)
-        self._spawn(self._sweeper)
-        with dispatch.run_inline(self._pool):
-            yield
+        try:
+            if not self.inline:
+                yield
+                return
+            self._pool = ThreadPoolExecutor(max_workers=len(self.gateways) + 2)
+            self._spawn(self._sweeper)
+            with dispatch.run_inline(self._pool):
+                yield
+        finally:
+            self._stop.set()
+            for thread in self._threads:
+                thread.join(10)
+            self._threads.clear()
 
     def _spawn(self, target: Any) -> None:
         thread = threading.Thread(target=target, daemon=True)
         thread.start()
         self._threads.append(thread)
 
-    def _wait(self, case_ids: list[int], timeout: float) -> None:
+    def wait(self, case_ids: list[int], timeout: float) -> bool:
+        """Waits until every case has ended or waits for a person (an open incident); False on timeout."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             still_open = Case.objects.filter(pk__in=case_ids, status__in=OPEN_CASE_STATUSES)
             stuck = Incident.objects.filter(case__in=still_open, resolved_at__isnull=True)
             if not still_open.exclude(pk__in=stuck.values("case_id")).exists():
-                return
+                return True
             time.sleep(0.05)
+        return False
 
     def _sweeper(self) -> None:
         while not self._stop.wait(0.5):
@@ -202,6 +222,7 @@ class Simulation:
                 jobs.sweep()
             finally:
                 close_old_connections()
+        connections.close_all()
 
     def _operators(self) -> None:
         """Every operator starts an offered task at once and completes it after a short delay."""
@@ -212,6 +233,7 @@ class Simulation:
                 self._operate(due, users)
             finally:
                 close_old_connections()
+        connections.close_all()  # this thread's: it would outlive the run
 
     def _operate(self, due: dict[int, float], users: dict[int, User]) -> None:
         items = WorkItem.objects.filter(
