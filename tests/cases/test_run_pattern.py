@@ -1,0 +1,130 @@
+"""`manage.py run_pattern --simulate`: every thesis example runs to completion, and its trace keeps
+every constraint as pattern-format.md defines it at run time."""
+
+from __future__ import annotations
+
+import io
+import json
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import pytest
+from django.core.management import CommandError, call_command
+
+from hrc.engine.document import read_pattern
+from hrc.engine.execution import supporter_of
+from hrc.engine.model import Pattern
+from hrc.engine.runtime import CaseNet
+
+EXAMPLES = sorted((Path(__file__).parents[2] / "hrc" / "patterns" / "examples").glob("*.json"))
+EVENTS = {
+    "task-started",
+    "task-completed",
+    "task-interrupted",
+    "task-resumed",
+    "case-completed",
+    "case-failed",
+}
+
+Event = dict[str, Any]
+
+
+def run_pattern(path: Path, *options: str) -> list[Event]:
+    out = io.StringIO()
+    call_command("run_pattern", str(path), "--simulate", "--json", *options, stdout=out)
+    return [json.loads(line) for line in out.getvalue().splitlines()]
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_each_example_runs_to_completion_keeping_its_constraints(path: Path) -> None:
+    events = run_pattern(path, "--cases", "3", "--time-scale", "0.02", "--seed", "7")
+    pattern = read_pattern(json.loads(path.read_text()))
+
+    assert [e["seq"] for e in events] == list(range(1, len(events) + 1))
+    assert all(set(e) == {"seq", "at", "case", "task", "actor", "event"} for e in events)
+    assert {e["event"] for e in events} <= EVENTS
+    cases = {e["case"] for e in events}
+    assert len(cases) == 3
+    for case in cases:
+        trace = [e for e in events if e["case"] == case]
+        assert trace[-1]["event"] == "case-completed"
+        check_trace(pattern, trace)
+
+
+def check_trace(pattern: Pattern, trace: list[Event]) -> None:
+    """Each task runs start-to-completion; time, func and space hold at every event."""
+    started: Counter[str] = Counter()
+    completed: Counter[str] = Counter()
+    interrupted: set[str] = set()
+    space = CaseNet(pattern).space_pairs
+    for event in trace:
+        task, kind = event["task"], event["event"]
+        if kind == "task-started":
+            for c in pattern.constraints:
+                if c.type == "time" and c.target == task:
+                    assert completed[c.source] > started[task], f"time {c.source}→{task}: {event}"
+                if c.type == "func" and supporter_of(pattern, c)[1] == task:
+                    supporter = supporter_of(pattern, c)[0]
+                    assert started[supporter] > completed[supporter], (
+                        f"func: {supporter} not running"
+                    )
+            for pair in space:
+                if task == pair.cobot_task:
+                    # The cobot does not start into an operator's shared area.
+                    assert started[pair.operator_task] == completed[pair.operator_task], event
+                if (
+                    task == pair.operator_task
+                    and started[pair.cobot_task] > completed[pair.cobot_task]
+                ):
+                    assert pair.cobot_task in interrupted or _next_is_interruption(
+                        trace, event, pair.cobot_task
+                    )
+            started[task] += 1
+        elif kind == "task-completed":
+            assert started[task] == completed[task] + 1, f"{task} completed without running"
+            for c in pattern.constraints:
+                if c.type == "func" and supporter_of(pattern, c)[0] == task:
+                    supported = supporter_of(pattern, c)[1]
+                    assert completed[supported] == started[supported] > 0, (
+                        f"func: {supported} not done"
+                    )
+            completed[task] += 1
+            interrupted.discard(task)
+        elif kind == "task-interrupted":
+            assert started[task] == completed[task] + 1, "only a running cobot task is interrupted"
+            interrupted.add(task)
+        elif kind == "task-resumed":
+            interrupted.discard(task)
+    assert started == completed
+    assert started and set(started) <= {t.id for _, t in pattern.transitions() if t.is_task}
+
+
+def _next_is_interruption(trace: list[Event], event: Event, cobot_task: str) -> bool:
+    """The operator's start and the cobot's interruption are one transaction: adjacent events."""
+    after = trace[trace.index(event) + 1 :]
+    return any(e["event"] == "task-interrupted" and e["task"] == cobot_task for e in after[:3])
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_cooperation_with_a_space_constraint_records_its_interruptions() -> None:
+    path = next(p for p in EXAMPLES if p.stem == "coop_1o1c_polishing")
+    events = run_pattern(path, "--cases", "4", "--time-scale", "0.05", "--seed", "3")
+
+    kinds = Counter(e["event"] for e in events)
+    assert kinds["case-completed"] == 4
+    assert kinds["task-interrupted"] == kinds["task-resumed"]
+
+
+@pytest.mark.django_db
+def test_a_file_that_does_not_check_names_its_errors(tmp_path: Path) -> None:
+    broken = tmp_path / "broken.json"
+    broken.write_text(
+        json.dumps({"format": "hrc-pattern/1", "name": "x", "actors": [], "processes": []})
+    )
+
+    with pytest.raises(CommandError, match="cannot run"):
+        run_pattern(broken)
+    with pytest.raises(CommandError, match="Cannot read"):
+        run_pattern(tmp_path / "missing.json")
