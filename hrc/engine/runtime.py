@@ -178,7 +178,7 @@ class CaseNet:
     def why_not(self, marking: Marking, transition: str) -> str:
         """What a transition waits for, as a person says it; "" when it is enabled."""
         missing = [
-            self._needs.get(place, f"a token in {place}")
+            self._needs.get(place) or _waiting_for(place)
             for place, weight in self._transitions[transition].pre
             if marking.get(place) < weight
         ]
@@ -191,6 +191,12 @@ class CaseNet:
         if not net_transition.is_enabled(marking):
             raise NotEnabled(f"{what}: it waits for {self.why_not(marking, transition)}.")
         return net_transition.fire(marking)
+
+
+def _waiting_for(place: str) -> str:
+    if place.startswith("running:"):
+        return f"{place.removeprefix('running:')} to be running"
+    return f"a token in {place}"
 
 
 def apply_outputs(
@@ -228,8 +234,15 @@ def correlates(message: MessageConfig, data: Mapping[str, Any], keys: Mapping[st
         return False
     for key, text in message.correlation.items():
         try:
-            if expressions.evaluate(text, {"data": data}) != keys[key]:
+            if not _same_json_value(expressions.evaluate(text, {"data": data}), keys[key]):
                 return False
         except expressions.ExpressionError:
             return False
     return True
+
+
+def _same_json_value(ours: Any, theirs: Any) -> bool:
+    """Equal as JSON values: true is not 1, "1" is not 1 (Python's == says True == 1)."""
+    if isinstance(ours, bool) or isinstance(theirs, bool):
+        return type(ours) is type(theirs) and ours == theirs
+    return bool(ours == theirs)

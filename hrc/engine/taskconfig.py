@@ -47,6 +47,9 @@ DEVICE_CALLS: Final[Mapping[str, tuple[str, tuple[str, ...], tuple[str, ...]]]] 
     "display.show": ("Devices/Display/Show", ("text",), ()),
 }
 
+# How a space constraint interrupts the cobot (its "interrupt" key); pause by default.
+INTERRUPT_MODES: Final = ("pause", "slow")
+
 # Names expressions may use: case data everywhere, a task's result in its outputs.
 DATA_NAMES: Final = frozenset({"data"})
 OUTPUT_NAMES: Final = frozenset({"data", "result"})
@@ -163,9 +166,11 @@ def _step(t: str, raw: object, default_program: object) -> StepConfig:
     poses = raw.get("poses", [])
     for name, value in (("number", number), ("workspace", workspace)):
         if not expressions.is_expression(value) and (
-            isinstance(value, bool) or not isinstance(value, int)
+            isinstance(value, bool) or not isinstance(value, int) or value < 0
         ):
-            raise ConfigError(t, f"the step's '{name}' must be a whole number or an expression.")
+            raise ConfigError(
+                t, f"the step's '{name}' must be a whole number ≥ 0 or an expression."
+            )
         _check_value(t, f"step {name}", value)
     if expressions.is_expression(poses):
         _check_value(t, "step poses", poses)
@@ -266,8 +271,26 @@ def config_issues(pattern: Pattern) -> list[Issue]:
                         raise ConfigError(transition.id, f"only silent transitions have a '{key}'.")
                 task_config(pattern, transition)
             else:
-                guard_of(transition)
-                message_of(transition)
+                if "task" in transition.extra:
+                    raise ConfigError(transition.id, "a silent transition runs no 'task'.")
+                if guard_of(transition) is not None and message_of(transition) is not None:
+                    raise ConfigError(
+                        transition.id,
+                        "a transition waits for a message or has a guard, not both: "
+                        "put the guard on a silent transition after it.",
+                    )
         except ConfigError as problem:
             issues.append(error("task-config", str(problem), transition.id))
+    for constraint in pattern.constraints:
+        mode = constraint.extra.get("interrupt", "pause")
+        if constraint.type == "space" and mode not in INTERRUPT_MODES:
+            issues.append(
+                error(
+                    "task-config",
+                    f"The space constraint {constraint.source} → {constraint.target} has "
+                    f"interrupt {mode!r}; it must be one of {', '.join(INTERRUPT_MODES)}.",
+                    constraint.source,
+                    constraint.target,
+                )
+            )
     return issues

@@ -393,6 +393,7 @@ def test_a_message_correlates_only_with_equal_keys() -> None:
     assert not correlates(message, data, {})
     assert not correlates(message, data, {"order": 7, "line": 2})
     assert not correlates(message, {}, {"order": 7})  # the case has no order yet
+    assert not correlates(message, {"order": 1}, {"order": True})  # JSON: true is not 1
 
 
 # Space pairs ----------------------------------------------------------------------------

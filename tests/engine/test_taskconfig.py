@@ -158,10 +158,10 @@ def test_all_the_poses_may_come_from_one_expression() -> None:
 @pytest.mark.parametrize(
     ("step", "complaint"),
     [
-        ({"number": "2"}, "'number' must be a whole number or an expression"),
-        ({"number": True}, "'number' must be a whole number or an expression"),
-        ({"number": 1.5}, "'number' must be a whole number or an expression"),
-        ({"workspace": None}, "'workspace' must be a whole number or an expression"),
+        ({"number": "2"}, "'number' must be a whole number ≥ 0 or an expression"),
+        ({"number": True}, "'number' must be a whole number ≥ 0 or an expression"),
+        ({"number": 1.5}, "'number' must be a whole number ≥ 0 or an expression"),
+        ({"workspace": None}, "'workspace' must be a whole number ≥ 0 or an expression"),
         ({"program": ""}, "'program' must be a program name"),
         ({"program": 3}, "'program' must be a program name"),
         ({"poses": [[0] * 6] * 3}, "at most 2 poses"),
@@ -429,11 +429,26 @@ def test_config_issues_are_task_config_errors_naming_each_transition() -> None:
 def test_a_well_configured_pattern_has_no_config_issues() -> None:
     data = _doc(
         tc1={"task": {"step": {"number": "=data.step"}, "outputs": {"done": "True"}}},
-        x1={"guard": "data.ok", "message": {"name": "go", "correlation": {"id": "data.id"}}},
+        x1={"message": {"name": "go", "correlation": {"id": "data.id"}}},
         to1={"task": {"form": {"type": "object"}, "timeout": 600, "retries": 0}},
     )
 
     assert config_issues(read_pattern(data)) == []
+
+
+def test_a_guard_and_a_message_on_one_transition_are_refused() -> None:
+    data = _doc(x1={"guard": "data.ok", "message": {"name": "go"}})
+
+    [issue] = config_issues(read_pattern(data))
+    assert issue.elements == ("x1",) and "not both" in issue.message
+
+
+def test_a_space_constraint_interrupts_only_by_pause_or_slow() -> None:
+    data = two_lanes([("to1", "tc2", "space")], declared="cooperation")
+    data["constraints"][0]["interrupt"] = "Slow"
+
+    [issue] = config_issues(read_pattern(data))
+    assert "'Slow'" in issue.message and issue.elements == ("to1", "tc2")
 
 
 def test_check_document_reports_task_config_errors() -> None:
