@@ -18,12 +18,13 @@ from django.db import IntegrityError, transaction
 from django.utils import timezone
 
 from hrc.cases.choices import CaseStatus, EventType
-from hrc.cases.errors import Invalid
+from hrc.cases.errors import Conflict, Invalid
 from hrc.cases.models import Case, Message
 from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, correlates
 from hrc.organisations.models import Organisation
+from hrc.patterns.models import PatternVersion
 
 DEFAULT_TTL_SECONDS = 3600
 MAX_TTL_SECONDS = 7 * 24 * 3600
@@ -49,7 +50,7 @@ def receive_message(
         raise Invalid(f"'ttl_seconds' must be 1–{MAX_TTL_SECONDS}.")
     existing = Message.objects.filter(organisation=organisation, message_id=message_id).first()
     if existing is not None:
-        return existing, False
+        return _same_message(existing, name, correlation, payload), False
     try:
         with transaction.atomic():
             message = Message.objects.create(
@@ -58,18 +59,48 @@ def receive_message(
                 expires_at=timezone.now() + dt.timedelta(seconds=ttl_seconds), sent_by=sent_by,
             )  # fmt: skip
     except IntegrityError:  # the same id, sent twice at once: the other send won
-        return Message.objects.get(organisation=organisation, message_id=message_id), False
+        first = Message.objects.get(organisation=organisation, message_id=message_id)
+        return _same_message(first, name, correlation, payload), False
     _deliver(message)
+    message.refresh_from_db()
     return message, True
+
+
+def _same_message(
+    first: Message,
+    name: str,
+    correlation: Mapping[str, Any] | None,
+    payload: Mapping[str, Any] | None,
+) -> Message:
+    """The first message with this id, when this send repeats it; Conflict when it says something else."""
+    if (first.name, first.correlation, first.payload) != (
+        name,
+        dict(correlation or {}),
+        dict(payload or {}),
+    ):
+        raise Conflict(
+            f"Message id {first.message_id!r} was used before for a different message "
+            f"({first.name!r}); a repeated send must be identical, a new message needs a new id."
+        )
+    return first
 
 
 def _deliver(message: Message) -> None:
     """Offers the message to each running case of the organisation waiting for its name."""
     from hrc.cases import services
 
-    candidates = Case.objects.filter(
+    running = Case.objects.filter(
         organisation_id=message.organisation_id, status=CaseStatus.RUNNING
-    ).values_list("pk", flat=True)
+    )
+    versions = PatternVersion.objects.filter(cases__in=running).distinct()
+    listening = [
+        v.pk for v in versions if any(m.name == message.name for m in case_net(v).messages.values())
+    ]
+    candidates = (
+        running.filter(version_id__in=listening)
+        .order_by("started_at", "id")
+        .values_list("pk", flat=True)
+    )
     for case_id in candidates:
         with transaction.atomic():
             case = services.lock_case(case_id)

@@ -2,13 +2,23 @@
 
 from functools import lru_cache
 
+from hrc.cases.errors import Invalid
 from hrc.engine.document import read_pattern
 from hrc.engine.runtime import CaseNet
+from hrc.engine.taskconfig import ConfigError
 from hrc.patterns.models import PatternVersion
 
 
 def case_net(version: PatternVersion) -> CaseNet:
-    return _compiled(version.pk, version)
+    """The version compiled; raises Invalid when its task configuration cannot run.
+
+    (Publishing checks the configuration, so only a version published before
+    that check existed can fail here.)
+    """
+    try:
+        return _compiled(version.pk, version)
+    except ConfigError as problem:
+        raise Invalid(f"{version} cannot run: {problem}") from None
 
 
 @lru_cache(maxsize=256)

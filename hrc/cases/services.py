@@ -41,7 +41,6 @@ from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, resolve
 from hrc.engine.taskconfig import POSE_LENGTH, TaskConfig
-from hrc.organisations.models import Membership
 from hrc.patterns.models import PatternVersion
 
 # advance() repeats settle → messages → held completions until nothing changes;
@@ -143,13 +142,13 @@ def resume_case(case: Case, *, by: User | None) -> Case:
 
 
 def may_perform(user: User, item: WorkItem) -> bool:
-    """Whether the user is one of the operator work item's candidates (directly or by team)."""
-    if item.candidates.filter(pk=user.pk).exists():
-        return True
-    return (
-        item.team_id is not None
-        and Membership.objects.filter(user_id=user.pk, teams__id=item.team_id).exists()
-    )
+    """Whether the user is one of the operator work item's candidates (directly or by team),
+    and still a member of the case's organisation (selectors.performable_by is the rule)."""
+    from hrc.cases.selectors import performable_by
+
+    return WorkItem.objects.filter(
+        performable_by(user), pk=item.pk, case__organisation__memberships__user_id=user.pk
+    ).exists()
 
 
 def claim_work_item(item: WorkItem, *, user: User) -> WorkItem:

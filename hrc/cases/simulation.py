@@ -271,7 +271,7 @@ class Simulation:
                 continue
             if kind.startswith("case-"):
                 ended.add(case)
-                task = actor = None
+                task = actor = ""
             events.append((at, case, task or None, actor or None, kind))
         for case in case_ids:
             if case not in ended:

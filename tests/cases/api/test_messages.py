@@ -102,6 +102,16 @@ def test_a_repeated_message_id_is_harmless_and_answers_with_the_first_message(
     assert len(waiting) == 1
 
 
+def test_a_message_id_reused_for_another_message_is_a_409(
+    engineer_client: APIClient, message_version: PatternVersion
+) -> None:
+    assert _send(engineer_client, "id-1", "A-1").status_code == 201
+    reused = _send(engineer_client, "id-1", "B-2")
+    assert reused.status_code == 409
+    assert "new message needs a new id" in reused.data["detail"]
+    assert Message.objects.count() == 1
+
+
 def test_an_operator_cannot_send_a_message(
     operator_client: APIClient, message_version: PatternVersion
 ) -> None:
