@@ -32,7 +32,7 @@ from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus, WorkItemKind, Work
 from hrc.cases.errors import CaseError
 from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
 from hrc.cases.nets import case_net
-from hrc.cobots.drivers.runner import driver_for
+from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot
 from hrc.engine.model import Pattern
@@ -150,9 +150,13 @@ class Simulation:
             organisation=self.organisation, name=name, endpoint=gateway.endpoint
         )
 
+    def cobot(self, actor: str) -> SyncDriver:
+        """A driver to the actor's simulated cobot, to look at it or to play the person at the cell."""
+        return driver_for(self._cobot_names[actor], self.gateways[actor].endpoint)
+
     def executed_steps(self, actor: str) -> tuple[int, list[str]]:
         """What the actor's simulated cobot counted: (executions, the tokens of the latest ones)."""
-        driver = driver_for(self._cobot_names[actor], self.gateways[actor].endpoint)
+        driver = self.cobot(actor)
         return int(driver.read("Simulator/Executions")), list(
             driver.read("Simulator/ExecutedSteps")
         )
@@ -182,10 +186,11 @@ class Simulation:
         return [services.start_case(self.version, started_by=None).pk for _ in range(count)]
 
     @contextlib.contextmanager
-    def running(self) -> Iterator[None]:
+    def running(self, *, operators: bool = True) -> Iterator[None]:
         """Operators at work (and, inline, the jobs and the sweeper) while inside."""
         self._stop.clear()
-        self._spawn(self._operators)
+        if operators:
+            self._spawn(self._operators)
         try:
             if not self.inline:
                 yield

@@ -43,3 +43,70 @@ def cobot_chain(steps: int = 4, timeout: float = 5.0) -> dict[str, Any]:
         ],
         "constraints": [],
     }
+
+
+def _process(
+    tasks: list[dict[str, Any]], arcs: list[list[str]], places: list[str]
+) -> dict[str, Any]:
+    return {
+        "id": "N", "workpiece": "w", "actors": ["c", "o"],
+        "places": [{"id": p, "tokens": 1 if p == "p0" else 0} for p in places],
+        "transitions": tasks, "arcs": arcs,
+    }  # fmt: skip
+
+
+def _document(name: str, process: dict[str, Any], constraints: list[Any]) -> dict[str, Any]:
+    return {
+        "format": "hrc-pattern/1",
+        "name": name,
+        "actors": [
+            {"id": "c", "type": "cobot", "program": PROGRAM},
+            {"id": "o", "type": "operator"},
+        ],
+        "processes": [process],
+        "constraints": constraints,
+    }
+
+
+def scan_until_found() -> dict[str, Any]:
+    """Load; scan for a part until one is found (a guarded loop); pick it at the pose the scan
+    gave; show the pose's x on the cobot's display."""
+    tasks = [
+        {"id": "to1", "performer": "o", "label": "load"},
+        {"id": "tc_scan", "performer": "c", "label": "scan", "task": {
+            "device": {"call": "part-detection.scan"},
+            "outputs": {"detected": "result.detected", "pose": "result.pose"}}},
+        {"id": "found", "guard": "data.detected"},
+        {"id": "again", "guard": "not data.detected"},
+        {"id": "tc_pick", "performer": "c", "label": "move to the part", "task": {
+            "step": {"number": 2, "workspace": 0, "poses": "=[data.pose]"}}},
+        {"id": "tc_show", "performer": "c", "label": "show", "task": {
+            "device": {"call": "display.show", "args": {"text": "=str(data.pose[0])"}}}},
+    ]  # fmt: skip
+    arcs = [
+        ["p0", "to1"], ["to1", "p1"], ["p1", "tc_scan"], ["tc_scan", "p2"],
+        ["p2", "found"], ["found", "p3"], ["p2", "again"], ["again", "p1"],
+        ["p3", "tc_pick"], ["tc_pick", "p4"], ["p4", "tc_show"], ["tc_show", "p5"],
+    ]  # fmt: skip
+    return _document("Scan until found", _process(tasks, arcs, [f"p{i}" for i in range(6)]), [])
+
+
+def shared_space(mode: str = "pause") -> dict[str, Any]:
+    """Load; then the cobot picks (tc1) while the operator inspects (to2) in a shared area."""
+    tasks = [
+        {"id": "to1", "performer": "o", "label": "load"},
+        {"id": "split"},
+        {"id": "tc1", "performer": "c", "label": "pick", "task": {
+            "step": {"number": PICK}, "timeout": 30}},
+        {"id": "to2", "performer": "o", "label": "inspect"},
+        {"id": "join"},
+    ]  # fmt: skip
+    arcs = [
+        ["p0", "to1"], ["to1", "p1"], ["p1", "split"], ["split", "p2"], ["split", "p3"],
+        ["p2", "tc1"], ["tc1", "p4"], ["p3", "to2"], ["to2", "p5"],
+        ["p4", "join"], ["p5", "join"], ["join", "p6"],
+    ]  # fmt: skip
+    constraint = {"from": "to2", "to": "tc1", "type": "space", "interrupt": mode}
+    return _document(
+        "Shared space", _process(tasks, arcs, [f"p{i}" for i in range(7)]), [constraint]
+    )

@@ -98,7 +98,8 @@ def check_trace(pattern: Pattern, trace: list[Event]) -> None:
         elif kind == "task-resumed":
             interrupted.discard(task)
     assert started == completed
-    assert started and set(started) <= {t.id for _, t in pattern.transitions() if t.is_task}
+    assert started
+    assert set(started) <= {t.id for _, t in pattern.transitions() if t.is_task}
 
 
 def _next_is_interruption(trace: list[Event], event: Event, cobot_task: str) -> bool:
