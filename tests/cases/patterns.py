@@ -71,7 +71,7 @@ def _document(name: str, process: dict[str, Any], constraints: list[Any]) -> dic
 def scan_until_found() -> dict[str, Any]:
     """Load; scan for a part until one is found (a guarded loop); pick it at the pose the scan
     gave; show the pose's x on the cobot's display."""
-    tasks = [
+    tasks: list[dict[str, Any]] = [
         {"id": "to1", "performer": "o", "label": "load"},
         {"id": "tc_scan", "performer": "c", "label": "scan", "task": {
             "device": {"call": "part-detection.scan"},
@@ -93,7 +93,7 @@ def scan_until_found() -> dict[str, Any]:
 
 def shared_space(mode: str = "pause") -> dict[str, Any]:
     """Load; then the cobot picks (tc1) while the operator inspects (to2) in a shared area."""
-    tasks = [
+    tasks: list[dict[str, Any]] = [
         {"id": "to1", "performer": "o", "label": "load"},
         {"id": "split"},
         {"id": "tc1", "performer": "c", "label": "pick", "task": {

@@ -31,9 +31,10 @@ def until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
 
 
 def _operator_task(case: Case, task: str) -> WorkItem:
-    return until(
+    item: WorkItem = until(
         lambda: WorkItem.objects.filter(case=case, task=task, state=WorkItemState.OFFERED).first()
     )
+    return item
 
 
 def _do(simulation: Simulation, case: Case, task: str) -> WorkItem:
