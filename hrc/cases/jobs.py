@@ -373,55 +373,56 @@ def _expire_lease(job_id: int, case_id: int) -> None:
 # Interruptions (space constraints) ------------------------------------------------------
 
 
+def _locked_interruption(interruption_id: int) -> Interruption:
+    return (
+        Interruption.objects.select_for_update(of=("self",))
+        .select_related("cobot")
+        .get(pk=interruption_id)
+    )
+
+
+def _command(interruption: Interruption, *, pause: bool) -> bool:
+    """Pauses or resumes (slows or restores the speed of) the cobot; records why when it cannot."""
+    driver = driver_for_cobot(interruption.cobot)
+    try:
+        if interruption.mode == "slow":
+            speed = SLOW_OVERRIDE_PERCENT if pause else FULL_OVERRIDE_PERCENT
+            driver.write({urua.STATE_OVERRIDE: speed})
+        else:
+            driver.call("PauseProgram" if pause else "StartProgram")
+    except DriverError as error:
+        interruption.error = f"{'pause' if pause else 'resume'}: {error}"
+        interruption.save(update_fields=["error"])
+        return False
+    return True
+
+
 def interrupt_cobot(interruption_id: int) -> None:
     """Pauses (or slows) the cobot for an interruption still open; never twice."""
     with transaction.atomic():
-        interruption = (
-            Interruption.objects.select_for_update(of=("self",))
-            .select_related("cobot")
-            .get(pk=interruption_id)
-        )
+        interruption = _locked_interruption(interruption_id)
         if interruption.ended_at is not None or interruption.paused_at is not None:
             return
-        driver = driver_for_cobot(interruption.cobot)
-        try:
-            if interruption.mode == "slow":
-                driver.write({urua.STATE_OVERRIDE: SLOW_OVERRIDE_PERCENT})
-            else:
-                driver.call("PauseProgram")
-        except DriverError as error:
-            interruption.error = f"pause: {error}"
-            interruption.save(update_fields=["error"])
-            return
-        interruption.paused_at = timezone.now()
-        interruption.save(update_fields=["paused_at"])
+        if _command(interruption, pause=True):
+            interruption.paused_at = timezone.now()
+            interruption.save(update_fields=["paused_at"])
 
 
 def resume_cobot(interruption_id: int) -> None:
-    """Resumes the cobot after an interruption that paused it, when no other keeps it paused."""
+    """Resumes the cobot after an interruption that paused it, when no other keeps it paused.
+
+    A resume that fails is left for the sweeper, which sends it again until it succeeds.
+    """
     with transaction.atomic():
-        interruption = (
-            Interruption.objects.select_for_update(of=("self",))
-            .select_related("cobot")
-            .get(pk=interruption_id)
-        )
+        interruption = _locked_interruption(interruption_id)
         if interruption.ended_at is None or interruption.resumed_at is not None:
             return
-        if interruption.paused_at is not None:
-            others = Interruption.objects.filter(
-                cobot=interruption.cobot, ended_at__isnull=True, paused_at__isnull=False
-            ).exclude(pk=interruption.pk)
-            if not others.exists():
-                driver = driver_for_cobot(interruption.cobot)
-                try:
-                    if interruption.mode == "slow":
-                        driver.write({urua.STATE_OVERRIDE: FULL_OVERRIDE_PERCENT})
-                    else:
-                        driver.call("StartProgram")
-                except DriverError as error:
-                    interruption.error = f"resume: {error}"
-                    interruption.save(update_fields=["error"])
-                    raise
+        others = Interruption.objects.filter(
+            cobot=interruption.cobot, ended_at__isnull=True, paused_at__isnull=False
+        ).exclude(pk=interruption.pk)
+        needed = interruption.paused_at is not None and not others.exists()
+        if needed and not _command(interruption, pause=False):
+            return
         interruption.resumed_at = timezone.now()
         interruption.save(update_fields=["resumed_at"])
     # The cobot's queue waited for this interruption to settle.

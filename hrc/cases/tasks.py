@@ -26,7 +26,7 @@ def interrupt_cobot(interruption_id: int) -> None:
     jobs.interrupt_cobot(interruption_id)
 
 
-@shared_task(ignore_result=True, autoretry_for=(Exception,), retry_backoff=True, max_retries=5)
+@shared_task(ignore_result=True)
 def resume_cobot(interruption_id: int) -> None:
     jobs.resume_cobot(interruption_id)
 
