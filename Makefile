@@ -42,9 +42,10 @@ $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
 	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
 	@touch $@
 
-bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC UA; JSON in bench/results/
+bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC UA, case runtime; JSON in bench/results/
 	$(PY) -m bench.run
 	$(PY) -m bench.handshake
+	$(PY) -m bench.runtime
 
 lock:  ## re-resolve requirements/*.in into the lock files
 	python3 -m venv /tmp/hrc-lock && /tmp/hrc-lock/bin/pip -q install uv

@@ -1,0 +1,1014 @@
+"""`make bench` (third part): the case runtime — step signalling, throughput, cost per step.
+
+Everything runs on this machine and is thrown away afterwards: a scratch
+PostgreSQL database (hrc_bench_<pid>: created, migrated, dropped), a private
+redis-server as the broker, real Celery workers (`WorkerProcess`), simulated
+OPC UA gateways at time scale 0 (a step takes no simulated time) and the API
+served over HTTP on 127.0.0.1 from a thread of this process. In one run:
+
+(a) step signalling: from just before the HTTP request that completes an
+    operator task to the moment an observer's subscription on the cobot's
+    gateway sees input Int26 (the fencing token's step id) become the id of the
+    job that completion enabled. Floors in the same run: a raw asyncua write of
+    one Int32 register (its response; its sight by the observer), a bare
+    Celery dispatch, one durable PostgreSQL commit. Target: p50 <= 10 ms,
+    p99 <= 50 ms.
+(b) throughput: completed cases per second of a one-cobot-task pattern, with
+    one and with two workers (concurrency 1 each). Target: >= 250 per second.
+(c) one operator step (start and complete through the services) in cases
+    whose logs hold ~10 and ~1000 events: the cost must not grow.
+
+Results: bench/results/runtime-<UTC>.json (and -latest.json), and a table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import http.client
+import json
+import os
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import asdict, dataclass, field, replace
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Self
+from urllib.parse import urlsplit, urlunsplit
+
+from celery import Celery
+
+from bench.handshake import percentile
+
+if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the functions
+    from django.contrib.auth.models import User
+
+    from hrc.cases.launcher import RedisProcess, WorkerProcess
+    from hrc.cobots.gateway.launcher import GatewayProcess
+    from hrc.cobots.models import Cobot
+    from hrc.patterns.models import PatternVersion
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS_DIR = ROOT / "bench" / "results"
+TARGET_P50_MS, TARGET_P99_MS, TARGET_CASES_PER_SECOND = 10.0, 50.0, 250.0
+SETTINGS_MODULE = "hrc.settings.test"  # dev's DEBUG would keep every query in memory
+DEFAULT_DATABASE_SERVER = "postgres://postgres@127.0.0.1:5432"
+PROGRAM, STEP = "Coexistence_PickAndPlace", 3  # step 3, "pick": a 2 s wait, zero at time scale 0
+FLOOR_REGISTER, FLOOR_VALUES_FROM = "Int29", 1_000_000  # an input no handshake writes
+# An operator is never as quick as the bench: give the worker the moment it
+# needs to answer the doorbell its own finish rang before the next step starts.
+SETTLE_SECONDS = 0.01
+
+# The Celery floor: a bare app configured as hrc's (acks late, prefetch 1; its
+# worker prefork, concurrency 1) whose one task hands back, through Redis, the
+# wall-clock time its first line ran at. Its worker imports this module, which
+# is why nothing at module level imports Django or hrc.
+FLOOR_BROKER_ENV, FLOOR_QUEUE = "HRC_BENCH_FLOOR_BROKER", "bench-floor"
+floor_app = Celery("hrc-bench-floor", broker=os.environ.get(FLOOR_BROKER_ENV, "memory://"))
+floor_app.conf.update(
+    task_acks_late=True, worker_prefetch_multiplier=1, task_default_queue=FLOOR_QUEUE
+)
+_floor_redis: Any = None
+
+
+# Celery ships no type hints (pyproject.toml says the same for hrc's tasks).
+@floor_app.task(name="bench.runtime.note_start", ignore_result=True)  # type: ignore[untyped-decorator]
+def note_start(key: str) -> None:
+    """Pushes time.time() of the task's first line onto the list `key` of the broker's Redis."""
+    started = time.time()
+    global _floor_redis
+    if _floor_redis is None:
+        import redis
+
+        _floor_redis = redis.Redis.from_url(os.environ[FLOOR_BROKER_ENV])
+    _floor_redis.rpush(key, repr(started))
+
+
+# The patterns and the settings ------------------------------------------------------------
+
+SIGNAL_SHAPE = "p1 → to1 (operator) → p2 → tc1 (cobot: Coexistence_PickAndPlace step 3) → p3"
+LOOP_SHAPE = (
+    "p0 → begin → p1 → to1 (operator) → p2 → again [data.again] → p1 | done [not data.again] "
+    "→ p3 → tc1 (cobot) → p4; the cases keep data.again true"
+)
+
+
+def _document(
+    name: str, places: str, transitions: list[dict[str, Any]], arcs: str
+) -> dict[str, Any]:
+    """One process, operator o and cobot c; `arcs` as "a>b b>c …"."""
+    first, *rest = places.split()
+    process = {
+        "id": "N",
+        "workpiece": "w",
+        "actors": ["c", "o"],
+        "places": [{"id": first, "tokens": 1}, *({"id": p} for p in rest)],
+        "transitions": transitions,
+        "arcs": [arc.split(">") for arc in arcs.split()],
+    }
+    actors = [{"id": "c", "type": "cobot", "program": PROGRAM}, {"id": "o", "type": "operator"}]
+    return {"format": "hrc-pattern/1", "name": name, "actors": actors, "processes": [process]}
+
+
+def _tasks() -> list[dict[str, Any]]:
+    step = {"step": {"program": PROGRAM, "number": STEP}}
+    return [
+        {"id": "to1", "performer": "o", "label": "place part"},
+        {"id": "tc1", "performer": "c", "label": "pick", "task": step},
+    ]
+
+
+def signal_pattern() -> dict[str, Any]:
+    """The smallest publishable pattern with one cobot task: every actor must perform a task,
+    so an operator task comes first (SIGNAL_SHAPE)."""
+    return _document("bench: operator, cobot", "p1 p2 p3", _tasks(), "p1>to1 to1>p2 p2>tc1 tc1>p3")
+
+
+def loop_pattern() -> dict[str, Any]:
+    """The operator task again and again while data.again holds (LOOP_SHAPE)."""
+    silent = [
+        {"id": "begin"},
+        {"id": "again", "guard": "data.again"},
+        {"id": "done", "guard": "not data.again"},
+    ]
+    arcs = "p0>begin begin>p1 p1>to1 to1>p2 p2>again again>p1 p2>done done>p3 p3>tc1 tc1>p4"
+    return _document("bench: operator loop", "p0 p1 p2 p3 p4", _tasks() + silent, arcs)
+
+
+@dataclass(frozen=True)
+class Settings:
+    steps: int = 500  # (a) timed steps
+    warmup: int = 50  # (a) untimed steps first, and untimed floor samples
+    floor_samples: int = 1000  # (a) timed samples of each floor
+    cases: int = 1000  # (b) cases per row
+    cobots: int = 4  # (b) simulated cobots, one job queue each
+    workers: tuple[int, ...] = (1, 2)  # (b) one row per worker count
+    repeats: int = 50  # (c) timed steps in each case length
+    events: int = 1000  # (c) the long case's log
+    quick: bool = False
+    results_dir: Path = field(default=RESULTS_DIR, compare=False)
+
+
+QUICK: dict[str, Any] = {
+    "steps": 20,
+    "warmup": 5,
+    "floor_samples": 100,
+    "cases": 40,
+    "cobots": 2,
+    "repeats": 10,
+}
+
+
+def summary(values_ms: Sequence[float]) -> dict[str, float]:
+    ordered = list(values_ms)
+    return {
+        "n": len(ordered),
+        **{
+            f"{name}_ms": round(percentile(ordered, q), 3)
+            for name, q in (("p50", 0.5), ("p99", 0.99))
+        },
+        "mean_ms": round(statistics.fmean(ordered), 3),
+        "min_ms": round(min(ordered), 3),
+        "max_ms": round(max(ordered), 3),
+    }
+
+
+# The machinery: database, observer, HTTP, the floor worker ----------------------------------
+
+
+def database_server() -> str:
+    """DATABASE_URL's PostgreSQL server (without its database), or the local default."""
+    parts = urlsplit(os.environ.get("DATABASE_URL", ""))
+    if parts.scheme not in ("postgres", "postgresql") or not parts.netloc:
+        return DEFAULT_DATABASE_SERVER
+    return urlunsplit((parts.scheme, parts.netloc, "", "", ""))
+
+
+@contextlib.contextmanager
+def scratch_database(server: str) -> Iterator[str]:
+    """Creates hrc_bench_<pid> on `server` and yields its URL; drops it, sessions and all."""
+    import psycopg
+
+    name = f"hrc_bench_{os.getpid()}"
+
+    def admin(statement: str) -> None:
+        with psycopg.connect(f"{server}/postgres", autocommit=True) as connection:
+            connection.execute(statement)
+
+    admin(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+    admin(f'CREATE DATABASE "{name}"')
+    try:
+        yield f"{server}/{name}"
+    finally:
+        admin(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+
+
+class Observer:
+    """An OPC UA client of one gateway, on its own thread, noting when input registers change.
+
+    It subscribes as the driver does (publishing interval 0, sampling 0) and
+    keeps the perf_counter() of the first notification of each (register,
+    value): it sees a written value when and as the cobot's program would.
+    """
+
+    def __init__(self, endpoint: str, cobot: str, registers: Sequence[str]) -> None:
+        self.endpoint, self.cobot, self.registers = endpoint, cobot, tuple(registers)
+        self._loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(target=self._loop.run_forever, daemon=True)
+        self._seen: dict[tuple[str, Any], float] = {}
+        self._names: dict[Any, str] = {}
+        self._changed = threading.Condition()
+        self._client: Any = None
+
+    def start(self) -> Self:
+        self._thread.start()
+        asyncio.run_coroutine_threadsafe(self._connect(), self._loop).result(30)
+        return self
+
+    async def _connect(self) -> None:
+        from asyncua import Client, ua
+
+        from hrc.cobots import urua
+
+        self._client = Client(self.endpoint)
+        await self._client.connect()
+        nodes = [
+            self._client.get_node(urua.node_id(self.cobot, urua.register_path("Inputs", name)))
+            for name in self.registers
+        ]
+        self._names = {node.nodeid: name for node, name in zip(nodes, self.registers, strict=True)}
+        # The heartbeat too: asyncua recreates a subscription quiet for a second,
+        # and a notification could fall into the gap.
+        nodes.append(self._client.get_node(urua.node_id(self.cobot, urua.STATE_HEARTBEAT)))
+        parameters = ua.CreateSubscriptionParameters(
+            RequestedPublishingInterval=0,
+            RequestedLifetimeCount=300,
+            RequestedMaxKeepAliveCount=100,
+            PublishingEnabled=True,
+        )
+        subscription = await self._client.create_subscription(parameters, self)
+        await subscription.subscribe_data_change(nodes, queuesize=16, sampling_interval=0)
+
+    def datachange_notification(self, node: Any, value: Any, data: Any) -> None:
+        now = time.perf_counter()
+        register = self._names.get(node.nodeid)
+        if register is not None:  # not the heartbeat
+            with self._changed:
+                self._seen.setdefault((register, value), now)
+                self._changed.notify_all()
+
+    def status_change_notification(self, status: Any) -> None:
+        pass  # the gateway went away: seen_at times out and says so
+
+    def seen_at(self, register: str, value: int, timeout: float = 30.0) -> float:
+        """perf_counter() when `register` first held `value`; TimeoutError when it never did."""
+        with self._changed:
+            if not self._changed.wait_for(lambda: (register, value) in self._seen, timeout):
+                raise TimeoutError(f"{self.cobot}: {register} never became {value}")
+            return self._seen[(register, value)]
+
+    def close(self) -> None:
+        if self._client is not None:
+            future = asyncio.run_coroutine_threadsafe(self._client.disconnect(), self._loop)
+            with contextlib.suppress(Exception):
+                future.result(10)
+        self._loop.call_soon_threadsafe(self._loop.stop)
+        self._thread.join(10)
+
+
+class ApiServer:
+    """Django's WSGI application on 127.0.0.1 (wsgiref, one thread) and a JSON client for it."""
+
+    def __init__(self) -> None:
+        from wsgiref.simple_server import WSGIRequestHandler, make_server
+
+        from django.core.wsgi import get_wsgi_application
+
+        class Quiet(WSGIRequestHandler):
+            def log_message(self, format: str, *args: Any) -> None:
+                pass  # a line per request would bury the table
+
+        self._server = make_server("127.0.0.1", 0, get_wsgi_application(), handler_class=Quiet)
+        self._thread = threading.Thread(target=self._server.serve_forever, daemon=True)
+
+    def start(self) -> Self:
+        self._thread.start()
+        return self
+
+    def connect(self) -> http.client.HTTPConnection:
+        """An open connection, so that a timed request does not pay for the TCP handshake."""
+        connection = http.client.HTTPConnection("127.0.0.1", self._server.server_port, timeout=30)
+        connection.connect()
+        return connection
+
+    def post(
+        self, path: str, body: Mapping[str, Any], token: str = "", connection: Any = None
+    ) -> tuple[int, Any]:
+        connection = connection or self.connect()
+        headers = {"Content-Type": "application/json"}
+        if token:
+            headers["Authorization"] = f"Token {token}"
+        try:
+            connection.request("POST", path, json.dumps(body), headers)
+            response = connection.getresponse()
+            return response.status, json.loads(response.read() or b"null")
+        finally:
+            connection.close()
+
+    def stop(self) -> None:
+        self._server.shutdown()
+        self._server.server_close()
+
+
+class FloorWorker:
+    """`celery -A bench.runtime:floor_app worker` with hrc's worker options, in its own group."""
+
+    def __init__(self, workdir: Path, broker: str) -> None:
+        self.broker, self.log = broker, workdir / "floor-worker.log"
+        self.process: subprocess.Popen[bytes] | None = None
+
+    def start(self, timeout: float = 60.0) -> Self:
+        command = [sys.executable, "-m", "celery", "-A", "bench.runtime:floor_app", "worker",
+                   "--hostname", "floor@%h", "--pool", "prefork", "--concurrency", "1",
+                   "--loglevel", "INFO", "--without-gossip", "--without-mingle",
+                   "--without-heartbeat", "--queues", FLOOR_QUEUE]  # fmt: skip
+        with self.log.open("ab") as log:
+            self.process = subprocess.Popen(
+                command,
+                cwd=ROOT,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env={**os.environ, FLOOR_BROKER_ENV: self.broker, "PYTHONUNBUFFERED": "1"},
+                start_new_session=True,
+            )
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and self.process.poll() is None:
+            if " ready." in self.log.read_text(errors="replace"):
+                return self
+            time.sleep(0.05)
+        self.stop()
+        raise RuntimeError(f"The floor worker did not start:\n{self.log.read_text()[-4000:]}")
+
+    def stop(self) -> None:
+        if self.process is not None and self.process.poll() is None:
+            os.killpg(self.process.pid, signal.SIGTERM)
+            try:
+                self.process.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.process.pid, signal.SIGKILL)
+                self.process.wait(10)
+        self.process = None
+
+
+# The rig: everything the measurements share ---------------------------------------------------
+
+
+@dataclass
+class Rig:
+    workdir: Path
+    database_url: str
+    redis: RedisProcess
+    operator: User
+    token: str
+    signal: PatternVersion
+    loop: PatternVersion
+    cobots: list[Cobot]
+    gateways: list[GatewayProcess]
+    api: ApiServer
+    workers: list[WorkerProcess] = field(default_factory=list)
+
+    def use_workers(self, count: int) -> None:
+        """Exactly `count` workers running; the first runs the beat that runs the sweeper."""
+        from hrc.cases.launcher import WorkerProcess
+
+        while len(self.workers) > count:
+            self.workers.pop().stop()
+        environment = {
+            "DJANGO_SETTINGS_MODULE": SETTINGS_MODULE,
+            "DATABASE_URL": self.database_url,
+            "REDIS_URL": self.redis.url,
+            "HRC_SWEEP_SECONDS": "0.5",
+            "HRC_RETRY_BACKOFF": "0.2",
+        }
+        while len(self.workers) < count:
+            name, first = f"worker{len(self.workers)}", not self.workers
+            worker = WorkerProcess(self.workdir, name=name, environment=environment, beat=first)
+            self.workers.append(worker.start())
+
+    def worker_nodes(self) -> list[str]:
+        return [f"{worker.name}@{socket.gethostname()}" for worker in self.workers]
+
+
+@contextlib.contextmanager
+def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
+    from hrc.cases.launcher import RedisProcess
+
+    with contextlib.ExitStack() as stack:
+        workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="hrc-bench-")))
+        redis = RedisProcess(workdir).start()
+        stack.callback(redis.stop)
+        database_url = stack.enter_context(scratch_database(database_server()))
+        progress(f"scratch database {database_url.rsplit('/', 1)[1]}, broker {redis.url}")
+        _set_up_django(database_url, redis.url)
+        stack.callback(_close_connections)
+        gateways: list[GatewayProcess] = []
+        stack.callback(_stop_all, gateways)
+        made = _populate(workdir, settings.cobots, gateways)
+        api = ApiServer().start()
+        stack.callback(api.stop)
+        status, body = api.post("/api/token/", made.pop("credentials"))
+        if status != 200:
+            raise RuntimeError(f"POST /api/token/ answered {status}: {body}")
+        bench = Rig(
+            workdir, database_url, redis, token=body["token"], api=api, gateways=gateways, **made
+        )
+        stack.callback(bench.use_workers, 0)
+        yield bench
+
+
+def _stop_all(processes: Sequence[GatewayProcess]) -> None:
+    for process in processes:
+        process.stop()
+
+
+def _set_up_django(database_url: str, redis_url: str) -> None:
+    os.environ.update(
+        DJANGO_SETTINGS_MODULE=SETTINGS_MODULE, DATABASE_URL=database_url, REDIS_URL=redis_url
+    )
+    import django
+
+    django.setup()
+    from django.core.management import call_command
+
+    # Loads hrc's Celery app, as Django projects do at start-up: without it a
+    # shared task sent from this process would go to Celery's default app.
+    import hrc.celery  # noqa: F401
+
+    call_command("migrate", verbosity=0, interactive=False)
+
+
+def _close_connections() -> None:
+    from django.db import connections
+
+    connections.close_all()
+
+
+def _populate(workdir: Path, cobots: int, gateways: list[GatewayProcess]) -> dict[str, Any]:
+    """An organisation with an engineer and an operator, the cobots, the two patterns published."""
+    from django.contrib.auth.models import User
+
+    from hrc.cases import services
+    from hrc.cobots.drivers.runner import driver_for
+    from hrc.cobots.gateway.launcher import GatewayProcess
+    from hrc.cobots.models import Cobot
+    from hrc.organisations import services as organisations
+    from hrc.organisations.choices import Role
+    from hrc.patterns import services as patterns
+
+    organisation = organisations.create_organisation(name="Bench plant", slug="bench-plant")
+    engineer = User.objects.create_user("bench-engineer")
+    organisations.add_member(organisation, engineer, Role.ENGINEER)
+    credentials = {"username": "bench-operator", "password": uuid.uuid4().hex}
+    operator = User.objects.create_user(**credentials)
+    organisations.add_member(organisation, operator, Role.OPERATOR)
+    made: list[Cobot] = []
+    for number in range(1, cobots + 1):
+        name = f"cobot{number}"
+        gateway = GatewayProcess(name, workdir / f"{name}.json", time_scale=0.0)
+        gateways.append(gateway.start())
+        driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
+        driver.call("PowerOn", timeout=30)
+        driver.call("SelectProgram", PROGRAM)
+        driver.call("StartProgram")
+        driver.close()  # this process drives no cobot during the run
+        made.append(Cobot.objects.create(organisation=organisation, name=name, endpoint=gateway.endpoint))  # fmt: skip
+    versions = {}
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": made[0].pk}}
+    for key, document in (("signal", signal_pattern()), ("loop", loop_pattern())):
+        draft = patterns.create_pattern(organisation, name=document["name"], created_by=engineer, draft=document)  # fmt: skip
+        versions[key] = patterns.publish_pattern(draft, published_by=engineer)
+        services.set_default_actor_mapping(versions[key], mapping)
+    return {"operator": operator, "credentials": credentials, "cobots": made, **versions}
+
+
+# (a) step signalling ----------------------------------------------------------------------------
+
+
+def measure_signalling(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
+    from hrc.cobots import urua
+
+    bench.use_workers(1)
+    floors = {"celery_dispatch": _celery_floor(bench, settings)}
+    floors["db_commit"] = _commit_floor(bench.database_url, settings)
+    gateway, cobot = bench.gateways[0], bench.cobots[0]
+    observer = Observer(gateway.endpoint, cobot.name, [urua.FENCE_STEP, FLOOR_REGISTER]).start()
+    try:
+        floors.update(asyncio.run(_opcua_floors(observer, settings)))
+        progress(f"floors measured; {settings.warmup} + {settings.steps} steps through the API ...")
+        ours, responses, to_lease = zip(
+            *(_signal_one_step(bench, observer) for _ in range(settings.warmup + settings.steps)),
+            strict=True,
+        )
+    finally:
+        observer.close()
+    timed = slice(settings.warmup, None)
+    return _signalling_report(ours[timed], responses[timed], to_lease[timed], floors)
+
+
+def _signal_one_step(bench: Rig, observer: Observer) -> tuple[float, float, float]:
+    """A case to its operator task's start, then the timed completion over HTTP.
+
+    Returns ms from the request to the register seen, to the response, and to
+    the moment the worker began to lease the job.
+    """
+    from hrc.cases import services
+    from hrc.cases.models import Job, WorkItem
+    from hrc.cobots import urua
+
+    case = services.start_case(bench.signal, started_by=None)
+    item = WorkItem.objects.get(case=case, task="to1")
+    services.start_work_item(item, user=bench.operator)
+    connection = bench.api.connect()
+    time.sleep(SETTLE_SECONDS)
+    sent_wall, sent = time.time(), time.perf_counter()
+    path = f"/api/work-items/{item.pk}/complete/"
+    status, body = bench.api.post(path, {"data": {}}, bench.token, connection)
+    answered = time.perf_counter()
+    if status != 200:
+        raise RuntimeError(f"POST {path} answered {status}: {body}")
+    job_id = Job.objects.values_list("pk", flat=True).get(case=case)
+    seen = observer.seen_at(urua.FENCE_STEP, job_id)
+    _wait_completed(case.pk, case.pk)
+    leased = Job.objects.values_list("started_at", flat=True).get(pk=job_id)
+    assert leased is not None  # the job ran
+    return (seen - sent) * 1000, (answered - sent) * 1000, (leased.timestamp() - sent_wall) * 1000
+
+
+def _celery_floor(bench: Rig, settings: Settings) -> list[float]:
+    """apply_async of note_start to its first line in the floor worker, in ms (wall clocks)."""
+    import redis
+
+    client = redis.Redis.from_url(bench.redis.url)
+    floor_app.conf.broker_url = bench.redis.url
+    key, times = f"bench-floor-{uuid.uuid4().hex}", []
+    worker = FloorWorker(bench.workdir, bench.redis.url).start()
+    try:
+        for index in range(settings.warmup + settings.floor_samples):
+            sent = time.time()
+            note_start.apply_async((key,))
+            popped = client.blpop([key], timeout=30)
+            if popped is None:
+                raise RuntimeError("The floor worker ran nothing for 30 s.")
+            if index >= settings.warmup:
+                times.append((float(popped[1]) - sent) * 1000)
+    finally:
+        worker.stop()
+    return times
+
+
+def _commit_floor(database_url: str, settings: Settings) -> list[float]:
+    """One INSERT committed alone in the scratch database (durable as the server is set), ms."""
+    import psycopg
+
+    times: list[float] = []
+    with psycopg.connect(database_url, autocommit=True) as connection:
+        connection.execute("CREATE TABLE bench_commit_floor (value integer)")
+        for index in range(settings.warmup + settings.floor_samples):
+            started = time.perf_counter()
+            connection.execute("INSERT INTO bench_commit_floor VALUES (%s)", (index,))
+            if index >= settings.warmup:
+                times.append((time.perf_counter() - started) * 1000)
+        connection.execute("DROP TABLE bench_commit_floor")
+    return times
+
+
+async def _opcua_floors(observer: Observer, settings: Settings) -> dict[str, list[float]]:
+    """A raw write of one Int32 input register: its response, and its sight by the observer."""
+    from asyncua import Client, ua
+
+    from hrc.cobots import urua
+
+    raw = Client(observer.endpoint)
+    await raw.connect()
+    path = urua.register_path("Inputs", FLOOR_REGISTER)
+    node = raw.get_node(urua.node_id(observer.cobot, path))
+    answered: list[float] = []
+    seen: list[float] = []
+    try:
+        for index in range(settings.warmup + settings.floor_samples):
+            value = FLOOR_VALUES_FROM + index
+            started = time.perf_counter()
+            await node.write_value(ua.Variant(value, ua.VariantType.Int32))
+            response = time.perf_counter()
+            at = await asyncio.to_thread(observer.seen_at, FLOOR_REGISTER, value, 10.0)
+            if index >= settings.warmup:
+                answered.append((response - started) * 1000)
+                seen.append((at - started) * 1000)
+    finally:
+        await raw.disconnect()
+    return {"opcua_write": answered, "opcua_write_seen": seen}
+
+
+def _signalling_report(
+    ours: Sequence[float],
+    responses: Sequence[float],
+    to_lease: Sequence[float],
+    floors: Mapping[str, list[float]],
+) -> dict[str, Any]:
+    mine = summary(ours)
+    rows: dict[str, dict[str, Any]] = {name: summary(values) for name, values in floors.items()}
+    # What any design pays that records the completion before the cobot moves
+    # and moves it from a worker: a durable commit, a Celery hop, a write seen.
+    unavoidable = ["db_commit", "celery_dispatch", "opcua_write_seen"]
+    rows["floor_sum"] = {"of": unavoidable} | {
+        key: round(sum(rows[name][key] for name in unavoidable), 3) for key in ("p50_ms", "p99_ms")
+    }
+    return {
+        "pattern": SIGNAL_SHAPE,
+        "ours": mine,
+        "http_response": summary(responses),
+        "to_lease": summary(to_lease),
+        "floors": rows,
+        **{f"ratio_{q}": {name: round(mine[f"{q}_ms"] / row[f"{q}_ms"], 2) for name, row in rows.items()}
+           for q in ("p50", "p99")},
+        "target": {"p50_ms": TARGET_P50_MS, "p99_ms": TARGET_P99_MS},
+        "meets_target": mine["p50_ms"] <= TARGET_P50_MS and mine["p99_ms"] <= TARGET_P99_MS,
+    }  # fmt: skip
+
+
+def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 0.001) -> None:
+    """Returns once cases first..last have completed; raises naming one that failed or hangs.
+
+    Only the bench starts cases, so the range holds exactly the ones it started.
+    """
+    from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus
+    from hrc.cases.models import Case, Incident
+
+    cases = Case.objects.filter(pk__range=(first, last))
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if not cases.filter(status__in=OPEN_CASE_STATUSES).exists():
+            ended = cases.exclude(status=CaseStatus.COMPLETED).first()
+            if ended is None:
+                return
+            raise RuntimeError(f"Case {ended.pk} ended {ended.status}, not completed.")
+        incident = Incident.objects.filter(case__in=cases, resolved_at__isnull=True).first()
+        if incident is not None:
+            raise RuntimeError(f"Case {incident.case_id}: {incident.kind}: {incident.message}")
+        time.sleep(poll)
+    raise TimeoutError(f"Cases still open after {timeout:.0f} s.")
+
+
+# (b) throughput -------------------------------------------------------------------------------
+
+
+def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
+    rows = []
+    for count in settings.workers:
+        progress(f"throughput: {settings.cases} cases, {len(bench.cobots)} cobots, {count} worker(s) ...")  # fmt: skip
+        rows.append(_throughput_row(bench, settings.cases, count))
+    return {
+        "pattern": SIGNAL_SHAPE,
+        "cobots": len(bench.cobots),
+        "rows": rows,
+        "target_cases_per_second": TARGET_CASES_PER_SECOND,
+        "meets_target": max(row["cases_per_second"] for row in rows) >= TARGET_CASES_PER_SECOND,
+    }
+
+
+def _throughput_row(bench: Rig, cases: int, workers: int) -> dict[str, Any]:
+    """The cases are prepared while the workers consume nothing (each operator task done, each
+    cobot job queued, its doorbell waiting in the broker); then all workers take the queue."""
+    from django.db.models import Max, Min
+
+    from hrc.cases import services
+    from hrc.cases.models import Case, Job, WorkItem
+    from hrc.celery import app
+
+    bench.use_workers(workers)
+    queue = app.conf.task_default_queue
+    _control(app.control.cancel_consumer, queue, bench.worker_nodes())
+    started, ids = time.perf_counter(), []
+    for index in range(cases):
+        cobot = bench.cobots[index % len(bench.cobots)]
+        case = services.start_case(bench.signal, started_by=None, actor_mapping={"c": {"cobot": cobot.pk}})  # fmt: skip
+        item = WorkItem.objects.get(case=case, task="to1")
+        services.start_work_item(item, user=bench.operator)
+        services.complete_work_item(item, user=bench.operator, data={})
+        ids.append(case.pk)
+    prepared = time.perf_counter() - started
+    sessions = _sessions_opened()
+    meter = CpuMeter(lambda: _row_cpu(bench)).start()
+    released = time.time()
+    _control(app.control.add_consumer, queue, bench.worker_nodes())
+    _wait_completed(ids[0], ids[-1], timeout=600.0, poll=0.05)
+    cpu = meter.stop()
+    time.sleep(1.0)  # PostgreSQL publishes its statistics at most once a second
+    sessions = _sessions_opened() - sessions
+    ours = Case.objects.filter(pk__range=(ids[0], ids[-1]))
+    seconds = ours.aggregate(at=Max("ended_at"))["at"].timestamp() - released
+    jobs = Job.objects.filter(case__in=ours)
+    first = jobs.aggregate(at=Min("started_at"))["at"].timestamp() - released
+    spans = jobs.values_list("started_at", "ended_at")
+    runs = [(end - start).total_seconds() * 1000 for start, end in spans if start and end]
+    return {
+        "workers": workers,
+        "concurrency": 1,
+        "cases": cases,
+        "seconds": round(seconds, 3),
+        "cases_per_second": round(cases / seconds, 1),
+        "first_lease_ms": round(first * 1000, 3),
+        "job_lease_to_end": summary(runs),
+        "prepare_cases_per_second": round(cases / prepared, 1),
+        "db_sessions_opened_per_case": round(sessions / cases, 2),
+        "cpu_s": cpu,
+        "cpu_ms_per_case": cpu and {
+            role: round(used * 1000 / cases, 2) for role, used in cpu.items() if role != "window"
+        },
+    }  # fmt: skip
+
+
+def _sessions_opened() -> int:
+    """Sessions ever opened on the scratch database (PostgreSQL 14 or later)."""
+    from django.db import connection
+
+    with connection.cursor() as cursor:
+        cursor.execute("SELECT sessions FROM pg_stat_database WHERE datname = current_database()")
+        return int(cursor.fetchone()[0])
+
+
+def _control(command: Callable[..., Any], queue: str, nodes: list[str]) -> None:
+    replies = command(queue, destination=nodes, reply=True, timeout=10)
+    if len(replies) != len(nodes):
+        raise RuntimeError(f"{len(replies)} of {len(nodes)} workers answered: {replies}")
+
+
+def _row_cpu(bench: Rig) -> dict[str, dict[int, float]]:
+    """CPU seconds so far of each process of each role (see CpuMeter)."""
+    workers = [pid for worker in bench.workers for pid in worker.pids()]
+    gateways = [g.process.pid for g in bench.gateways if g.process is not None]
+    redis = [bench.redis.process.pid] if bench.redis.process is not None else []
+    return {
+        "workers": {pid: _cpu_of(pid) for pid in workers},
+        "postgres": _postgres_cpu(),
+        "gateways": {pid: _cpu_of(pid) for pid in gateways},
+        "redis": {pid: _cpu_of(pid) for pid in redis},
+        "bench": {os.getpid(): _cpu_of(os.getpid())},
+    }
+
+
+def _cpu_of(pid: int, reaped: bool = False) -> float:
+    """utime + stime of a process (and of its children that ended, when `reaped`); 0 if gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return 0.0
+    ticks = sum(int(value) for value in fields[11 : 15 if reaped else 13])
+    return ticks / os.sysconf("SC_CLK_TCK")
+
+
+def _postgres_cpu() -> dict[int, float]:
+    """Every process of a PostgreSQL server on this machine, anyone's sessions among them.
+
+    A Celery worker opens a session per task (Celery's Django fixup closes
+    connections around each task), so most sessions end inside the window:
+    their time is found in the server's children-that-ended time.
+    """
+    found = {}
+    for entry in Path("/proc").iterdir():
+        with contextlib.suppress(OSError):
+            if entry.name.isdigit() and (entry / "comm").read_text().strip() == "postgres":
+                found[int(entry.name)] = _cpu_of(int(entry.name), reaped=True)
+    return found
+
+
+class CpuMeter:
+    """CPU seconds per role over a window, from /proc (Linux; elsewhere `stop` gives None).
+
+    A process that appears during the window counts in full. `other` is the
+    machine's busy time less the roles: whatever else the machine was doing.
+    """
+
+    def __init__(self, roles: Callable[[], dict[str, dict[int, float]]]) -> None:
+        self._roles = roles
+        self._before: dict[str, Any] | None = None
+
+    def start(self) -> Self:
+        self._before = self._read()
+        return self
+
+    def stop(self) -> dict[str, float] | None:
+        before, after = self._before, self._read()
+        if before is None or after is None:
+            return None
+        used = {
+            role: sum(t - before["roles"].get(role, {}).get(pid, 0.0) for pid, t in pids.items())
+            for role, pids in after["roles"].items()
+        }
+        busy = after["busy"] - before["busy"]
+        used |= {"other": busy - sum(used.values()), "busy": busy}
+        return {"window": round(after["wall"] - before["wall"], 3)} | {
+            role: round(seconds, 3) for role, seconds in used.items()
+        }
+
+    def _read(self) -> dict[str, Any] | None:
+        try:
+            fields = [int(v) for v in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:9]]
+        except (OSError, ValueError):
+            return None
+        busy = (sum(fields) - fields[3] - fields[4]) / os.sysconf("SC_CLK_TCK")  # not idle, iowait
+        return {"wall": time.time(), "busy": busy, "roles": self._roles()}
+
+
+# (c) the cost of a step against the length of the log -----------------------------------------
+
+
+def measure_log_length(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
+    """One operator step timed alternately in a fresh ~10-event case and in one long case."""
+    from hrc.cases import services
+    from hrc.cases.models import Case
+
+    bench.use_workers(0)  # a quiet machine; the loop never reaches the cobot task
+    progress(f"log length: a case to {settings.events} events, {settings.repeats} steps each ...")
+    long_case = services.start_case(bench.loop, started_by=None, data={"again": True}).pk
+    long_before = _step_until(long_case, settings.events, bench.operator)
+    short, long, short_events = [], [], []
+    for _ in range(settings.repeats):
+        case = services.start_case(bench.loop, started_by=None, data={"again": True}).pk
+        short_events.append(_step_until(case, 10, bench.operator))
+        short.append(_one_step(case, bench.operator))
+        long.append(_one_step(long_case, bench.operator))
+    small, large = summary(short), summary(long)
+    long_after = Case.objects.values_list("last_seq", flat=True).get(pk=long_case)
+    return {
+        "pattern": LOOP_SHAPE,
+        "operation": "services.start_work_item + services.complete_work_item of to1",
+        "short": {"events_before": min(short_events), **small},
+        "long": {"events_before": long_before, "events_after": long_after, **large},
+        "ratio_p50": round(large["p50_ms"] / small["p50_ms"], 2),
+        "ratio_mean": round(large["mean_ms"] / small["mean_ms"], 2),
+    }
+
+
+def _step_until(case_id: int, events: int, user: User) -> int:
+    """Loops the case's operator task until its log holds `events` events; returns how many."""
+    from hrc.cases.models import Case
+
+    while (count := Case.objects.values_list("last_seq", flat=True).get(pk=case_id)) < events:
+        _one_step(case_id, user)
+    return count
+
+
+def _one_step(case_id: int, user: User) -> float:
+    from hrc.cases import services
+    from hrc.cases.choices import WorkItemState
+    from hrc.cases.models import WorkItem
+
+    item = WorkItem.objects.get(case_id=case_id, task="to1", state=WorkItemState.OFFERED)
+    started = time.perf_counter()
+    services.start_work_item(item, user=user)
+    services.complete_work_item(item, user=user, data={})
+    return (time.perf_counter() - started) * 1000
+
+
+# The run, the report, the table -----------------------------------------------------------------
+
+
+def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
+    load_before = _load()
+    with rig(settings, progress) as bench:
+        host = machine()  # while the database is there to say its version
+        signalling = measure_signalling(bench, settings, progress)
+        throughput = measure_throughput(bench, settings, progress)
+        log_length = measure_log_length(bench, settings, progress)
+    report = {
+        "benchmark": "runtime",
+        "when": datetime.now(UTC).isoformat(timespec="seconds"),
+        "machine": host,
+        "load_average": {"before": load_before, "after": _load()},
+        "settings": {key: value for key, value in asdict(settings).items() if key != "results_dir"},
+        "signalling": signalling,
+        "throughput": throughput,
+        "log_length": log_length,
+    }
+    settings.results_dir.mkdir(parents=True, exist_ok=True)
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+    for name in (f"runtime-{stamp}.json", "runtime-latest.json"):
+        (settings.results_dir / name).write_text(json.dumps(report, indent=2) + "\n")
+    return report
+
+
+def machine() -> dict[str, Any]:
+    from django.db import connection
+
+    from bench.run import machine as common
+
+    info = {key: value for key, value in common().items() if key != "pm4py"}
+    for package in ("django", "celery", "kombu", "asyncua", "psycopg"):
+        info[package] = metadata.version(package)
+    with connection.cursor() as cursor:
+        cursor.execute("SHOW server_version")
+        info["postgresql"] = cursor.fetchone()[0]
+    redis = subprocess.run(["redis-server", "--version"], capture_output=True, text=True, check=False)  # fmt: skip
+    info["redis_server"] = redis.stdout.strip()
+    return info
+
+
+def _load() -> list[float] | None:
+    with contextlib.suppress(OSError):
+        return [round(value, 2) for value in os.getloadavg()]
+    return None
+
+
+def print_table(report: Mapping[str, Any]) -> None:
+    signalling, throughput, log = report["signalling"], report["throughput"], report["log_length"]
+    floors = signalling["floors"]
+    print(f"\n(a) Step signalling, {signalling['ours']['n']} steps: HTTP complete → cobot's Int26 = job id")  # fmt: skip
+    print(f"{'':45} {'p50 ms':>8} {'p99 ms':>8} {'max ms':>8}   ours / row p50, p99")
+    rows = [
+        ("ours: request → register set", signalling["ours"], None),
+        ("  of which: request → HTTP response", signalling["http_response"], None),
+        ("  of which: request → worker starts the lease", signalling["to_lease"], None),
+        ("floor: raw asyncua write round trip", floors["opcua_write"], "opcua_write"),
+        ("floor: raw write seen by the observer", floors["opcua_write_seen"], "opcua_write_seen"),
+        ("floor: bare Celery apply_async → task runs", floors["celery_dispatch"], "celery_dispatch"),
+        ("floor: PostgreSQL insert, durable commit", floors["db_commit"], "db_commit"),
+        ("floor sum: commit + Celery + write seen", floors["floor_sum"], "floor_sum"),
+    ]  # fmt: skip
+    for label, row, key in rows:
+        ratios = f"   {signalling['ratio_p50'][key]:8.1f} {signalling['ratio_p99'][key]:8.1f}" if key else ""  # fmt: skip
+        most = f"{row['max_ms']:8.3f}" if "max_ms" in row else f"{'':8}"
+        print(f"{label:45} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f} {most}{ratios}")
+    verdict = "meets" if signalling["meets_target"] else "MISSES"
+    print(f"target p50 <= {TARGET_P50_MS:g} ms, p99 <= {TARGET_P99_MS:g} ms: {verdict}")
+
+    print(f"\n(b) Throughput: {throughput['cobots']} cobots, the pattern of (a), zero-time steps")
+    print(f"{'workers':>8} {'cases':>6} {'cases/s':>8} {'job ms p50':>11} {'prepare/s':>10} "
+          f"{'sessions':>9}  CPU ms per case")  # fmt: skip
+    for row in throughput["rows"]:
+        cpu = ", ".join(f"{role} {ms:.1f}" for role, ms in (row["cpu_ms_per_case"] or {}).items())
+        print(f"{row['workers']:>4} × {row['concurrency']} {row['cases']:>6} {row['cases_per_second']:>8.1f} "
+              f"{row['job_lease_to_end']['p50_ms']:>11.2f} {row['prepare_cases_per_second']:>10.1f} "
+              f"{row['db_sessions_opened_per_case']:>9.2f}  {cpu}")  # fmt: skip
+    verdict = "meets" if throughput["meets_target"] else "MISSES"
+    print(f"target >= {TARGET_CASES_PER_SECOND:g} cases/s: {verdict}")
+
+    print("\n(c) One operator step (start + complete) against the length of the case's log")
+    print(f"{'':12} {'events':>12} {'p50 ms':>8} {'p99 ms':>8} {'mean ms':>8}")
+    for label, row in (("short case", log["short"]), ("long case", log["long"])):
+        events = "–".join(str(row[k]) for k in ("events_before", "events_after") if k in row)
+        print(f"{label:12} {events:>12} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f} {row['mean_ms']:8.3f}")  # fmt: skip
+    print(f"long / short: p50 {log['ratio_p50']:.2f}, mean {log['ratio_mean']:.2f} (flat is 1)")
+    load, cores = report["load_average"]["before"], report["machine"]["cpu_count"]
+    if load:
+        print(f"load average {load[0]:.2f} on {cores} cores at the start; compare quiet runs only")
+
+
+def parse_args(argv: Sequence[str] | None = None) -> Settings:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help=f"a small run: {QUICK}")
+    for name, default in asdict(Settings()).items():
+        if isinstance(default, int) and not isinstance(default, bool):
+            parser.add_argument(f"--{name.replace('_', '-')}", type=int, help=f"default {default}")
+    parser.add_argument("--workers", help="(b) worker counts, comma-separated (default 1,2)")
+    parser.add_argument("--results-dir", type=Path, default=RESULTS_DIR)
+    arguments = parser.parse_args(argv)
+    settings = replace(Settings(), quick=arguments.quick, results_dir=arguments.results_dir)
+    if arguments.quick:
+        settings = replace(settings, **QUICK)
+    given = {k: v for k, v in vars(arguments).items() if k in QUICK or k == "events"}
+    for name, value in given.items():
+        if value is not None:
+            if value < (0 if name == "warmup" else 1):
+                parser.error(f"--{name.replace('_', '-')} must be at least 1 (warmup: 0)")
+            settings = replace(settings, **{name: value})
+    if arguments.workers:
+        try:
+            workers = tuple(int(count) for count in arguments.workers.split(","))
+        except ValueError:
+            workers = ()
+        if not workers or min(workers) < 1:
+            parser.error("--workers takes counts of 1 or more, e.g. 1,2")
+        settings = replace(settings, workers=workers)
+    return settings
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    settings = parse_args(argv)
+    # Killed politely (a CI timeout), still stop the workers and gateways and drop the database.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    print_table(run(settings, progress=lambda line: print(line, file=sys.stderr, flush=True)))
+
+
+if __name__ == "__main__":
+    main()
