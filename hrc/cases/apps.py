@@ -4,3 +4,9 @@ from django.apps import AppConfig
 class CasesConfig(AppConfig):
     name = "hrc.cases"
     verbose_name = "Running cases"
+
+    def ready(self) -> None:
+        # Load the Celery app with Django, so tasks sent from the web process use the
+        # configured broker, not Celery's default one. (Not in hrc/__init__.py: the
+        # engine under hrc/ must import without Django, and Celery's app loads it.)
+        import hrc.celery  # noqa: F401
