@@ -50,6 +50,7 @@ from hrc.cobots.drivers.base import (
 from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
 from hrc.engine.petri import Marking
+from hrc.engine.runtime import CaseNet
 
 logger = logging.getLogger(__name__)
 
@@ -114,13 +115,12 @@ def lease_next_job(cobot_id: int) -> Lease | None:
 
 
 def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -> Lease | None:
-    case = services.lock_case(case_id)
-    job = Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=job_id)
+    case, job = _lock_case_and_job(case_id, job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
     net = case_net(case.version)
-    waiting = _why_waiting(case, item)
+    waiting = _why_waiting(case, net, item)
     if not waiting and item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
     if waiting:
@@ -142,9 +142,15 @@ def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -
     )  # fmt: skip
 
 
-def _why_waiting(case: Case, item: WorkItem) -> str:
+def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
+    """Both rows locked, in the project's lock order (case, then job); the work item read along."""
+    case = services.lock_case(case_id)
+    job = Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=job_id)
+    return case, job
+
+
+def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     """Why a cobot task must not start now although the marking allows it; "" when it may."""
-    net = case_net(case.version)
     for pair in net.space_pairs:
         if pair.cobot_task != item.task:
             continue
@@ -282,10 +288,7 @@ def _backoff(retries_used: int) -> float:
 def _locked_job(lease: Lease) -> tuple[Case, Job | None]:
     """The case (locked) and the job, or None when this worker's lease is no longer the job's."""
     case_id = Job.objects.values_list("case_id", flat=True).get(pk=lease.job_id)
-    case = services.lock_case(case_id)
-    job = (
-        Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=lease.job_id)
-    )
+    case, job = _lock_case_and_job(case_id, lease.job_id)
     if job.state != JobState.RUNNING or job.lease != lease.lease:
         logger.info("Job %s: lease %s was lost; its outcome is dropped", job.pk, lease.lease)
         return case, None
@@ -345,8 +348,7 @@ def _first_due_per_cobot(now: dt.datetime) -> list[int]:
 
 def _expire_lease(job_id: int, case_id: int) -> None:
     with transaction.atomic():
-        case = services.lock_case(case_id)
-        job = Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=job_id)
+        case, job = _lock_case_and_job(case_id, job_id)
         if (
             job.state != JobState.RUNNING
             or job.lease_expires_at is None
