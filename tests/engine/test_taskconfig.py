@@ -440,7 +440,8 @@ def test_a_guard_and_a_message_on_one_transition_are_refused() -> None:
     data = _doc(x1={"guard": "data.ok", "message": {"name": "go"}})
 
     [issue] = config_issues(read_pattern(data))
-    assert issue.elements == ("x1",) and "not both" in issue.message
+    assert issue.elements == ("x1",)
+    assert "not both" in issue.message
 
 
 def test_a_space_constraint_interrupts_only_by_pause_or_slow() -> None:
@@ -448,7 +449,8 @@ def test_a_space_constraint_interrupts_only_by_pause_or_slow() -> None:
     data["constraints"][0]["interrupt"] = "Slow"
 
     [issue] = config_issues(read_pattern(data))
-    assert "'Slow'" in issue.message and issue.elements == ("to1", "tc2")
+    assert "'Slow'" in issue.message
+    assert issue.elements == ("to1", "tc2")
 
 
 def test_check_document_reports_task_config_errors() -> None:
