@@ -8,6 +8,9 @@ BENCH_STAMP := .venv/.bench-installed
 .DEFAULT_GOAL := help
 .PHONY: help install demo test lint bench lock clean
 
+# Browser tests drive Debian's chromium; Playwright never downloads a browser.
+CHROMIUM := /usr/bin/chromium
+
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
 
@@ -30,7 +33,10 @@ demo: install  ## load the example library, start two simulated cobots, serve on
 	trap 'kill %1 %2 2>/dev/null' EXIT; \
 	$(PY) manage.py runserver 127.0.0.1:8000
 
-test: install  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1)
+$(CHROMIUM):
+	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+
+test: install $(CHROMIUM)  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1, chromium for the browser tests)
 	$(PY) -m pytest -n 2 -p no:cacheprovider
 
 lint: install  ## ruff and mypy

@@ -1,0 +1,153 @@
+"""A real browser against a real server: Debian's chromium driven by Playwright.
+
+The server is `manage.py runserver` (daphne's, so HTTP and WebSockets go
+through ASGI as in production) in its own process, on the test database, so
+tests that use it need `transactional_db`: what a test writes must be
+committed for the server to see it. Screenshots go to var/screenshots/,
+which the run keeps.
+"""
+
+import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+from django.conf import settings
+from django.contrib.auth.models import User
+from playwright.sync_api import (
+    Browser,
+    BrowserContext,
+    Page,
+    Playwright,
+    ViewportSize,
+    sync_playwright,
+)
+
+from tests import factories
+
+CHROMIUM = "/usr/bin/chromium"
+SCREENSHOTS = Path(settings.BASE_DIR) / "var" / "screenshots"
+# A 10-inch tablet in landscape, the operators' device.
+TABLET = ViewportSize(width=1280, height=800)
+
+# Playwright's sync API runs an event loop in the test's thread, which makes
+# Django refuse ORM calls from that thread; the tests are synchronous code
+# that only looks async to Django, so the check does not apply.
+os.environ.setdefault("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def _wait_until_serving(url: str, server: subprocess.Popen[bytes], log: Path) -> None:
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        if server.poll() is not None:
+            raise RuntimeError(f"the test server exited; its log:\n{log.read_text()}")
+        try:
+            urllib.request.urlopen(f"{url}/accounts/login/", timeout=1).close()
+            return
+        except OSError:
+            time.sleep(0.1)
+    raise RuntimeError(f"the test server did not answer within 30 s; its log:\n{log.read_text()}")
+
+
+@pytest.fixture(scope="session")
+def live_url(django_db_setup: None, tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """The base URL of an ASGI server on the test database."""
+    from django.db import connection
+
+    database = connection.settings_dict
+    port = _free_port()
+    log = tmp_path_factory.mktemp("server") / "server.log"
+    environment = {
+        **os.environ,
+        "DJANGO_SETTINGS_MODULE": "hrc.settings.test",
+        "DATABASE_URL": f"postgres://{database['USER']}@{database['HOST']}:{database['PORT']}/{database['NAME']}",
+        "DJANGO_ALLOW_ASYNC_UNSAFE": "",
+    }
+    with log.open("wb") as output:
+        server = subprocess.Popen(
+            [
+                sys.executable,
+                "manage.py",
+                "runserver",
+                "--noreload",
+                "--insecure",
+                f"127.0.0.1:{port}",
+            ],
+            cwd=settings.BASE_DIR,
+            env=environment,
+            stdout=output,
+            stderr=subprocess.STDOUT,
+        )
+    url = f"http://127.0.0.1:{port}"
+    try:
+        _wait_until_serving(url, server, log)
+        yield url
+    finally:
+        server.terminate()
+        try:
+            server.wait(10)
+        except subprocess.TimeoutExpired:
+            server.kill()
+
+
+@pytest.fixture(scope="session")
+def playwright() -> Iterator[Playwright]:
+    with sync_playwright() as driver:
+        yield driver
+
+
+@pytest.fixture(scope="session")
+def browser(playwright: Playwright) -> Iterator[Browser]:
+    browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+    yield browser
+    browser.close()
+
+
+@pytest.fixture
+def context(browser: Browser) -> Iterator[BrowserContext]:
+    context = browser.new_context(viewport=TABLET, has_touch=True)
+    yield context
+    context.close()
+
+
+@pytest.fixture
+def page(context: BrowserContext) -> Page:
+    return context.new_page()
+
+
+@pytest.fixture
+def screenshot() -> Callable[[Page, str], Path]:
+    """Saves the page as var/screenshots/<name>.png and returns the path."""
+
+    def take(page: Page, name: str) -> Path:
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        path = SCREENSHOTS / f"{name}.png"
+        page.screenshot(path=str(path), full_page=True)
+        return path
+
+    return take
+
+
+@pytest.fixture
+def sign_in(live_url: str) -> Callable[[Page, User], None]:
+    """Signs the user in through the sign-in form, as a person would."""
+
+    def go(page: Page, user: User) -> None:
+        page.goto(f"{live_url}/accounts/login/")
+        page.get_by_label("User name").fill(user.get_username())
+        page.get_by_label("Password").fill(factories.PASSWORD)
+        page.get_by_role("button", name="Sign in").click()
+        page.wait_for_url(f"{live_url}/")
+
+    return go
