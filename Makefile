@@ -14,13 +14,25 @@ CHROMIUM := /usr/bin/chromium
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
 
+# The editor and the tablets' scripts: npm's locked toolchain, bundled by
+# esbuild into frontend/dist/, which Django serves as static files.
+NPM_STAMP := frontend/node_modules/.installed
+FRONTEND_BUILD := frontend/dist/.built
+$(NPM_STAMP): frontend/package-lock.json
+	cd frontend && npm ci --no-audit --no-fund --loglevel=error
+	@touch $@
+
+$(FRONTEND_BUILD): $(NPM_STAMP) frontend/build.mjs $(shell find frontend/src -type f 2>/dev/null)
+	cd frontend && npm run --silent build
+	@mkdir -p frontend/dist && touch $@
+
 $(STAMP): requirements/lock.txt
 	@test -x $(PY) || python3 -m venv .venv
 	$(PIP) install -r requirements/lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
 	@$(PY) -c "import django, rest_framework, channels, celery, asyncua" 
 	@touch $@
 
-install: $(STAMP)  ## create .venv and install the locked dependencies (idempotent)
+install: $(STAMP) $(FRONTEND_BUILD)  ## create .venv, install the locked Python and npm dependencies, build the frontend (idempotent)
 
 demo: install  ## load the example library, start two simulated cobots, serve on 127.0.0.1:8000
 	@mkdir -p var  # the embedded SQLite database lives here when DATABASE_URL is unset
@@ -37,12 +49,14 @@ $(CHROMIUM):
 	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
 
 test: install $(CHROMIUM)  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1, chromium for the browser tests)
+	@if [ -d frontend/test ]; then cd frontend && npx vitest run; fi
 	$(PY) -m pytest -n 2 -p no:cacheprovider
 
-lint: install  ## ruff and mypy
+lint: install  ## ruff, mypy and tsc
 	.venv/bin/ruff check .
 	.venv/bin/ruff format --check .
 	.venv/bin/mypy hrc tests bench
+	cd frontend && npx tsc --noEmit
 
 $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
 	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
@@ -59,4 +73,4 @@ lock:  ## re-resolve requirements/*.in into the lock files
 	/tmp/hrc-lock/bin/uv pip compile --python-version 3.11 requirements/bench.in -c requirements/lock.txt -o requirements/bench-lock.txt
 
 clean:  ## remove the venv, caches and the embedded database
-	rm -rf .venv var .mypy_cache .ruff_cache .pytest_cache .hypothesis
+	rm -rf .venv var frontend/node_modules frontend/dist .mypy_cache .ruff_cache .pytest_cache .hypothesis
