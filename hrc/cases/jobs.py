@@ -25,7 +25,7 @@ from typing import Any
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import Q
+from django.db.models import Exists, OuterRef, Q
 from django.utils import timezone
 
 from hrc.cases import dispatch, services
@@ -54,6 +54,8 @@ from hrc.engine.runtime import CaseNet
 
 logger = logging.getLogger(__name__)
 
+# What taking a job changes on its row.
+LEASED_FIELDS = ["state", "lease", "waiting_for", "held_by", "started_at", "lease_expires_at"]
 # Lease expiries of one job after which a person decides (a job that kills its worker).
 MAX_LEASE_EXPIRIES = 3
 SLOW_OVERRIDE_PERCENT = 10.0
@@ -65,6 +67,7 @@ class Lease:
     """What a worker needs to drive one job, read while it held the locks."""
 
     job_id: int
+    case_id: int
     lease: int
     attempt: int
     kind: str
@@ -98,10 +101,13 @@ def lease_next_job(cobot_id: int) -> Lease | None:
     """
     now = timezone.now()
     with transaction.atomic():
-        cobot = Cobot.objects.select_for_update().get(pk=cobot_id)
-        if Job.objects.filter(cobot=cobot, state=JobState.RUNNING).exists():
-            return None
-        if _unsettled_interruptions(cobot).exists():
+        busy = Job.objects.filter(cobot=OuterRef("pk"), state=JobState.RUNNING)
+        cobot = (
+            Cobot.objects.select_for_update(of=("self",))
+            .annotate(busy=Exists(busy), paused=Exists(_unsettled_interruptions(OuterRef("pk"))))
+            .get(pk=cobot_id)
+        )  # the lock and both reasons to wait in one query
+        if cobot.busy or cobot.paused:
             return None
         queued = Job.objects.filter(
             cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
@@ -134,10 +140,10 @@ def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -
     job.held_by = f"{socket.gethostname()}:{os.getpid()}"
     job.started_at = job.started_at or now
     job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
-    job.save()
+    job.save(update_fields=LEASED_FIELDS)
     case.save()
     return Lease(
-        job.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
+        job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
         sent_before=job.sent_at is not None,
     )  # fmt: skip
 
@@ -162,7 +168,7 @@ def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     return ""
 
 
-def _unsettled_interruptions(cobot: Cobot) -> Any:
+def _unsettled_interruptions(cobot: Cobot | OuterRef) -> Any:
     return Interruption.objects.filter(cobot=cobot).filter(
         Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
@@ -193,13 +199,19 @@ def _prepare(driver: SyncDriver, program: str, timeout: float) -> None:
     Never powers the arm on and never clears a stop: a cobot that is not
     running (powered, brakes released) is an incident for a person.
     """
-    state = driver.state()
-    loaded = str(state.get("CurrentProgram") or "")
-    if (
-        urua.program_base_name(loaded) == program
-        and state.get("ProgramState") == urua.PROGRAM_PLAYING
-    ):
+
+    def ready(state: dict[str, Any]) -> bool:
+        loaded = urua.program_base_name(str(state.get("CurrentProgram") or ""))
+        return loaded == program and state.get("ProgramState") == urua.PROGRAM_PLAYING
+
+    # The subscription's view saves a round trip per step; the step's own
+    # handshake reads afresh if the cobot is not ready after all.
+    if ready(driver.state(fresh=False)):
         return
+    state = driver.state()
+    if ready(state):
+        return
+    loaded = str(state.get("CurrentProgram") or "")
     if state.get("RobotMode") != urua.ROBOT_MODE_RUNNING:
         raise CobotNotReady(
             f"{driver.name} is in robot mode {state.get('RobotMode')!r}: power it on and release "
@@ -241,7 +253,7 @@ def finish_job(lease: Lease, result: dict[str, Any]) -> None:
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
         job.save(update_fields=["state", "result", "ended_at"])
         if case.status in (CaseStatus.RUNNING, CaseStatus.SUSPENDED):
-            services.advance(case, case_net(case.version))
+            services.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
         dispatch.send_on_commit("run_job", job.pk)
 
@@ -287,8 +299,7 @@ def _backoff(retries_used: int) -> float:
 
 def _locked_job(lease: Lease) -> tuple[Case, Job | None]:
     """The case (locked) and the job, or None when this worker's lease is no longer the job's."""
-    case_id = Job.objects.values_list("case_id", flat=True).get(pk=lease.job_id)
-    case, job = _lock_case_and_job(case_id, lease.job_id)
+    case, job = _lock_case_and_job(lease.case_id, lease.job_id)
     if job.state != JobState.RUNNING or job.lease != lease.lease:
         logger.info("Job %s: lease %s was lost; its outcome is dropped", job.pk, lease.lease)
         return case, None

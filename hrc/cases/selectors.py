@@ -22,9 +22,9 @@ from django.db.models import (
 from django.db.models.functions import Coalesce
 
 from hrc.cases.choices import OPEN_WORK_ITEM_STATES, JobState, WorkItemKind, WorkItemState
-from hrc.cases.models import Case, CaseEvent, Incident, Job, WorkItem
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.organisations.models import Team
-from hrc.organisations.selectors import AnyUser, organisations_of
+from hrc.organisations.selectors import AnyUser, organisations_of, writable_organisations
 
 # The jobs a cobot has still to do or is doing: its queue.
 QUEUE_STATES = (JobState.QUEUED, JobState.RUNNING)
@@ -53,10 +53,15 @@ def events_of(case: Case, *, after: int | None = None) -> QuerySet[CaseEvent]:
     return events if after is None else events.filter(seq__gt=after)
 
 
+def work_items_of_organisations_of(user: AnyUser) -> QuerySet[WorkItem]:
+    """The user's organisations' work items, bare: the wall, nothing read along."""
+    return WorkItem.objects.filter(case__organisation__in=organisations_of(user))
+
+
 def work_items_visible_to(user: AnyUser) -> QuerySet[WorkItem]:
     """Every work item, open or not, of the user's organisations' cases (read access)."""
     return (
-        WorkItem.objects.filter(case__organisation__in=organisations_of(user))
+        work_items_of_organisations_of(user)
         .select_related("case__version", "claimed_by", "completed_by", "cobot", "job")
         .annotate(queue_position=_queue_position("job__"))
     )
@@ -66,7 +71,7 @@ def performable_by(user: AnyUser) -> Q:
     """Operator work items offered to `user`: as a candidate or as a member of the item's team.
 
     Subqueries, not joins, so the rows stay one per item without DISTINCT; the
-    same rule as services.may_perform.
+    rule the work item services enforce (services._locked_item).
     """
     if not user.is_authenticated:
         return Q(pk__in=[])
@@ -152,4 +157,57 @@ def incidents_visible_to(user: AnyUser, *, open_only: bool = True) -> QuerySet[I
         incidents = incidents.filter(resolved_at__isnull=True)
     return incidents.select_related("case", "work_item", "resolved_by").order_by(
         "-opened_at", "-id"
+    )
+
+
+# The supervisor pages (engineers and admins) ---------------------------------------------
+
+
+def supervised_cases(user: AnyUser) -> QuerySet[Case]:
+    """The cases of the organisations where the user is an engineer or admin, newest first,
+    with `open_incident_count` annotated and `current_work_items` (open, in offer order)
+    prefetched."""
+    open_items = WorkItem.objects.filter(state__in=OPEN_WORK_ITEM_STATES).select_related(
+        "claimed_by", "cobot"
+    )
+    return (
+        Case.objects.filter(organisation__in=writable_organisations(user))
+        .select_related("version__pattern", "started_by")
+        .annotate(
+            open_incident_count=Count("incidents", filter=Q(incidents__resolved_at__isnull=True))
+        )
+        .prefetch_related(
+            Prefetch("work_items", open_items.order_by("offered_at", "id"), "current_work_items")
+        )
+        .order_by("-started_at", "-id")
+    )
+
+
+def supervised_incidents(user: AnyUser) -> QuerySet[Incident]:
+    """Unresolved incidents of the cases of the organisations where the user is an engineer or
+    admin, newest first, with their case's pattern."""
+    return (
+        Incident.objects.filter(
+            case__organisation__in=writable_organisations(user), resolved_at__isnull=True
+        )
+        .select_related("case__version__pattern", "work_item", "resolved_by")
+        .order_by("-opened_at", "-id")
+    )
+
+
+def incidents_of(case: Case) -> QuerySet[Incident]:
+    """All the case's incidents, resolved or not, newest first."""
+    return (
+        Incident.objects.filter(case=case)
+        .select_related("work_item", "resolved_by")
+        .order_by("-opened_at", "-id")
+    )
+
+
+def interruptions_of(case: Case) -> QuerySet[Interruption]:
+    """The case's interruptions in the order they began, with both tasks and the cobot."""
+    return (
+        Interruption.objects.filter(case=case)
+        .select_related("work_item", "operator_work_item", "cobot")
+        .order_by("started_at", "id")
     )

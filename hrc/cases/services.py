@@ -19,7 +19,7 @@ from typing import Any
 import jsonschema
 from django.contrib.auth.models import User
 from django.db import transaction
-from django.db.models import Q
+from django.db.models import Exists, OuterRef, Q
 from django.utils import timezone
 
 from hrc.cases import dispatch
@@ -139,16 +139,6 @@ def resume_case(case: Case, *, by: User | None) -> Case:
 
 
 # Operator work items ---------------------------------------------------------------
-
-
-def may_perform(user: User, item: WorkItem) -> bool:
-    """Whether the user is one of the operator work item's candidates (directly or by team),
-    and still a member of the case's organisation (selectors.performable_by is the rule)."""
-    from hrc.cases.selectors import performable_by
-
-    return WorkItem.objects.filter(
-        performable_by(user), pk=item.pk, case__organisation__memberships__user_id=user.pk
-    ).exists()
 
 
 def claim_work_item(item: WorkItem, *, user: User) -> WorkItem:
@@ -411,10 +401,13 @@ def _settle(case: Case, net: CaseNet) -> bool:
 
 def _complete_held_steps(case: Case, net: CaseNet) -> bool:
     """Completes cobot tasks whose step is done and whose func constraints now allow it."""
+    if not net.holdable_tasks:
+        return False  # no constraint can hold a completion: nothing is ever held
     done = False
     held = WorkItem.objects.filter(
-        case=case, state=WorkItemState.RUNNING, job__state=JobState.SUCCEEDED
-    ).select_related("job")
+        case=case, task__in=net.holdable_tasks, state=WorkItemState.RUNNING,
+        job__state=JobState.SUCCEEDED,
+    ).select_related("job")  # fmt: skip
     for item in held:
         if net.can_complete(Marking(case.marking), item.task):
             _complete(case, net, item, item.job.result or {}, None)
@@ -452,8 +445,11 @@ def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
         team_id=binding.get("team"), cobot_id=binding.get("cobot"),
     )  # fmt: skip
     if config.kind == "operator":
-        if binding.get("users"):
-            item.candidates.set(binding["users"])
+        # A new item has no candidates yet: insert them in one statement.
+        Candidate = WorkItem.candidates.through
+        Candidate.objects.bulk_create(
+            Candidate(workitem_id=item.pk, user_id=user_id) for user_id in binding.get("users", ())
+        )
     else:
         _queue_job(case, net, item, config)
     record_event(case, EventType.TASK_OFFERED, item=item)
@@ -530,6 +526,19 @@ def _start(case: Case, net: CaseNet, item: WorkItem, user: User | None) -> None:
         _interrupt_shared_space(case, net, item)
 
 
+def complete_cobot_task(
+    case: Case, net: CaseNet, item: WorkItem, result: Mapping[str, Any]
+) -> None:
+    """Completes a cobot task whose step is done, unless a func constraint still holds it
+    (then `advance` completes it once the constraint allows).
+
+    Call while holding the case row lock, with the item running; the caller saves the case.
+    """
+    if net.can_complete(Marking(case.marking), item.task):
+        _complete(case, net, item, result, None)
+    advance(case, net)
+
+
 def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
     """Starts a cobot task as its cobot takes the job (jobs.lease_next_job).
 
@@ -559,7 +568,8 @@ def _complete(
     item.result, item.completed_by = dict(result), user
     item.save(update_fields=["state", "ended_at", "result", "completed_by", "started_at"])
     record_event(case, EventType.TASK_COMPLETED, item=item, user=user, before=before, after=after)
-    _end_interruptions(case, Q(work_item=item) | Q(operator_work_item=item))
+    if item.task in net.space_tasks:  # only a space constraint's tasks are ever interrupted
+        _end_interruptions(case, Q(work_item=item) | Q(operator_work_item=item))
 
 
 # Space constraints: interruptions ------------------------------------------------------
@@ -622,11 +632,16 @@ def lock_case(case_id: int) -> Case:
 
 def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:
     """The case (locked) and a fresh copy of an operator work item the user may perform."""
+    from hrc.cases.selectors import performable_by
+
     case = lock_case(item.case_id)
-    item = WorkItem.objects.get(pk=item.pk)
+    offered = WorkItem.objects.filter(
+        performable_by(user), pk=OuterRef("pk"), case__organisation__memberships__user_id=user.pk
+    )  # a candidate (or in the item's team) and still a member; read with the item in one query
+    item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item.pk)
     if item.kind != WorkItemKind.OPERATOR:
         raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
-    if not may_perform(user, item):
+    if not item.performable:
         raise NotAllowed(f"{item.label} is not offered to you.")
     return case, item
 

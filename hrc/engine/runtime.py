@@ -78,6 +78,16 @@ class CaseNet:
             if message is not None:
                 self.messages[transition.id] = message
         self.space_pairs = self._space_pairs()
+        self.space_tasks = frozenset(
+            task for pair in self.space_pairs for task in (pair.operator_task, pair.cobot_task)
+        )
+        # Tasks whose completion a constraint place can hold back (func): only
+        # their finished steps need looking for again after each firing.
+        self.holdable_tasks = frozenset(
+            task
+            for task in self.tasks
+            if any(place in self._needs for place, _ in self._transitions[f"complete:{task}"].pre)
+        )
 
     def _space_pairs(self) -> tuple[SpacePair, ...]:
         pairs = []

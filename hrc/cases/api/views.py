@@ -5,7 +5,7 @@ organisations: an outsider gets 404 and empty lists, also on POST actions.
 Roles are checked per object after that: engineers and admins start, cancel,
 suspend and resume cases, resolve incidents, send messages and set actor
 mappings; operators get 403. Work items are the services' to allow
-(services.may_perform). The services' refusals (hrc.cases.errors) reach the
+(services._locked_item, by selectors.performable_by). The services' refusals (hrc.cases.errors) reach the
 client as 400, 403 or 409 with a `detail` (hrc.api.exceptions).
 """
 
@@ -192,6 +192,9 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
 
     def get_queryset(self) -> QuerySet[WorkItem]:
         user = self.request.user
+        if self.action in ("claim", "unclaim", "start", "complete"):
+            # The wall only: the service reads the item again under the case lock.
+            return selectors.work_items_of_organisations_of(user)
         if self.action != "list":
             return selectors.work_items_visible_to(user)
         items = selectors.task_list(user, _kinds(self.request))
