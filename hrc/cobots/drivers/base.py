@@ -139,8 +139,12 @@ class CobotDriver(abc.ABC):
         """
 
     @abc.abstractmethod
-    async def state(self) -> dict[str, Any]:
-        """The cobot's state: robot mode, safety mode, program state, program, last error."""
+    async def state(self, *, fresh: bool = True) -> dict[str, Any]:
+        """The cobot's state: robot mode, safety mode, program state, program, last error.
+
+        `fresh=False` may answer from what the driver already knows (a
+        subscription), when nothing it did since can have changed it.
+        """
 
     @abc.abstractmethod
     async def call(self, method: str, *arguments: Any, timeout: float | None = None) -> list[Any]:

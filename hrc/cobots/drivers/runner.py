@@ -77,8 +77,8 @@ class SyncDriver:
         limit = timeout or self.driver.step_timeout
         return _LOOP.run(self.driver.call(method, *arguments, timeout=limit), limit)
 
-    def state(self) -> dict[str, Any]:
-        return _LOOP.run(self.driver.state(), self.driver.connect_timeout)
+    def state(self, *, fresh: bool = True) -> dict[str, Any]:
+        return _LOOP.run(self.driver.state(fresh=fresh), self.driver.connect_timeout)
 
     def read(self, path: str) -> Any:
         return _LOOP.run(self.driver.read(path), self.driver.connect_timeout)

@@ -226,6 +226,8 @@ class OpcUaDriver(CobotDriver):
             raise
         self._alive = True
         self._heard_at = time.monotonic()
+        # The subscription's first values may still be on their way.
+        self._cache_behind = True
         self._wake()
 
     async def _explain_silent_gateway(self, error: BaseException) -> None:
@@ -526,12 +528,17 @@ class OpcUaDriver(CobotDriver):
 
     # Reads, writes, methods ------------------------------------------------------
 
-    async def state(self) -> dict[str, Any]:
+    async def state(self, *, fresh: bool = True) -> dict[str, Any]:
         await self._ensure_session(self._deadline(self.connect_timeout))
+        if not fresh and not self._cache_behind:
+            return self._state_from_cache()
         try:
             await self._refresh()  # fresh, not what the subscription has brought so far
         except _SessionLost as lost:
             raise self._unreachable(lost) from None
+        return self._state_from_cache()
+
+    def _state_from_cache(self) -> dict[str, Any]:
         return {path.rsplit("/", 1)[-1]: self.cache[path] for path in STATE_PATHS}
 
     async def read(self, path: str) -> Any:
