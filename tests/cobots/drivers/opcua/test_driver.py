@@ -6,7 +6,7 @@ import asyncio
 import time
 
 import pytest
-from asyncua import Client
+from asyncua import Client, ua
 
 from hrc.cobots import urua
 from hrc.cobots.drivers.base import (
@@ -166,3 +166,25 @@ async def test_the_driver_reconnects_after_dropped_connections(driver: OpcUaDriv
     assert result.outcome == "ran"
     ran = await driver.read("Simulator/ExecutedSteps")
     assert [line.split()[0] for line in ran] == ["17.1", "18.1"]
+
+
+async def test_a_cached_state_right_after_a_call_shows_the_calls_effect(
+    driver: OpcUaDriver, observer: Client
+) -> None:
+    await driver.call("PauseProgram")
+
+    # The call's effect may not have come through the subscription yet: the
+    # cheap read must not answer with the state from before it.
+    assert (await driver.state(fresh=False))["ProgramState"] == urua.PROGRAM_PAUSED
+
+
+async def test_a_cached_state_follows_what_others_do_to_the_cobot(
+    driver: OpcUaDriver, observer: Client
+) -> None:
+    await driver.state()
+    cobot = observer.get_node(urua.node_id("cobot1"))
+    pause = ua.NodeId.from_string(urua.node_id("cobot1", "PauseProgram"))
+    await cobot.call_method(pause)  # another client, not ours
+
+    await until(lambda: driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_PAUSED)
+    assert (await driver.state(fresh=False))["ProgramState"] == urua.PROGRAM_PAUSED
