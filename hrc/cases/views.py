@@ -1,0 +1,353 @@
+"""The supervisor pages: running cases, one case (its net with the live marking, timeline,
+interruptions, incidents), and the open incidents of the organisation.
+
+For engineers and admins, behind the API's organisation wall: a case of
+another organisation is a 404 whatever its id; in the user's organisation
+but without a writer's role, a 403. The pages only read. Resolving an
+incident is the page script's POST to the REST API (frontend/src/supervisor/),
+so the services' checks and refusal messages stay in one place; the same
+script keeps the marking, timeline and incidents up to date.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from django.contrib.auth.decorators import login_required
+from django.core.paginator import Paginator
+from django.http import Http404, HttpRequest, HttpResponse
+from django.shortcuts import render
+from django.urls import reverse
+from django.utils import timezone
+
+from hrc.cases import selectors
+from hrc.cases.choices import (
+    OPEN_CASE_STATUSES,
+    OPEN_WORK_ITEM_STATES,
+    CaseStatus,
+    EventType,
+    JobState,
+    WorkItemState,
+)
+from hrc.cases.drawing import ConstraintLine, NetDrawing, Node, draw_net
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
+from hrc.cases.nets import case_net
+from hrc.organisations.selectors import may_write_in, writable_organisations
+
+CASES_PER_PAGE = 50
+INCIDENTS_PER_PAGE = 50
+# A long case keeps thousands of events; a page shows this many, newest first.
+EVENTS_PER_PAGE = 50
+
+SUPERVISORS_ONLY = "Only engineers and admins of the organisation supervise its cases."
+# The list's filter: `open` (running or suspended, the default), one status, or `all`.
+STATE_FILTERS: dict[str, frozenset[str] | None] = {
+    "open": frozenset(OPEN_CASE_STATUSES),
+    **{status: frozenset({status}) for status in CaseStatus.values},
+    "all": None,
+}
+EVENT_NAMES = dict(EventType.choices)
+
+
+class Refused(Exception):
+    """A request the page answers with a status and a message (400, 403)."""
+
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def _refusal(request: HttpRequest, refused: Refused) -> HttpResponse:
+    return render(request, "cases/refused.html", {"message": str(refused)}, status=refused.status)
+
+
+# Running cases -----------------------------------------------------------------------------
+
+
+@login_required
+def case_list(request: HttpRequest) -> HttpResponse:
+    """The cases of the user's organisations, open ones by default; `?state=` filters."""
+    try:
+        _require_supervisor(request)
+        state = request.GET.get("state", "open")
+        if state not in STATE_FILTERS:
+            raise Refused(400, f"state must be one of {', '.join(STATE_FILTERS)}, not {state!r}.")
+    except Refused as refused:
+        return _refusal(request, refused)
+    cases = selectors.supervised_cases(request.user)
+    statuses = STATE_FILTERS[state]
+    if statuses is not None:
+        cases = cases.filter(status__in=sorted(statuses))
+    page = Paginator(cases, CASES_PER_PAGE).get_page(request.GET.get("page"))
+    return render(
+        request,
+        "cases/case_list.html",
+        {"page": page, "state": state, "states": list(STATE_FILTERS), "section": "cases"},
+    )
+
+
+def _require_supervisor(request: HttpRequest) -> None:
+    if not writable_organisations(request.user).exists():
+        raise Refused(403, SUPERVISORS_ONLY)
+
+
+# One case ----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class DrawnPlace:
+    node: Node
+    tokens: int
+
+
+@dataclass(frozen=True)
+class DrawnTask:
+    node: Node
+    state: str
+    """running, offered, incident (an open incident about it), or empty."""
+
+
+@dataclass(frozen=True)
+class DrawnConstraint:
+    line: ConstraintLine
+    tokens: int
+
+
+@dataclass(frozen=True)
+class TimelineRow:
+    seq: int
+    at: dt.datetime
+    who: str
+    what: str
+    type: str
+    task: str
+    task_label: str
+    change: list[str]
+    detail: str
+
+
+@dataclass(frozen=True)
+class InterruptionRow:
+    interruption: Interruption
+    seconds: float
+    ongoing: bool
+
+    @property
+    def duration(self) -> str:
+        return format_duration(self.seconds)
+
+
+@login_required
+def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
+    """One case: its net with the marking, open tasks, incidents, interruptions and timeline."""
+    try:
+        case = _supervised_case(request, pk)
+        before = _seq_param(request, "before")
+    except Refused as refused:
+        return _refusal(request, refused)
+    drawing = draw_net(case_net(case.version).pattern)
+    items = list(
+        selectors.work_items_visible_to(request.user).filter(
+            case=case, state__in=sorted(OPEN_WORK_ITEM_STATES)
+        )
+    )
+    incidents = list(selectors.incidents_of(case))
+    events, older = _timeline_page(case, before, drawing.labels)
+    context = {
+        "case": case,
+        "drawing": drawing,
+        "places": [DrawnPlace(n, case.marking.get(n.id, 0)) for n in drawing.places],
+        "tasks": _drawn_tasks(drawing, case.marking, items, incidents),
+        "constraints": [
+            DrawnConstraint(line, sum(case.marking.get(p, 0) for p in line.places))
+            for line in drawing.constraints
+        ],
+        "work_rows": [work_row(item) for item in items],
+        "incidents": incidents,
+        "interruptions": _interruption_rows(selectors.interruptions_of(case)),
+        "events": events,
+        "before": before,
+        "older": older,
+        "section": "cases",
+        "script": {
+            "page": "case",
+            "case": case.pk,
+            "lastSeq": case.last_seq,
+            # Only the newest page grows with new events; an older page stays as it is.
+            "live": before is None,
+            "labels": drawing.labels,
+            "api": {
+                "case": reverse("case-detail", args=[case.pk]),
+                "events": reverse("case-events", args=[case.pk]),
+                "incidents": f"{reverse('incident-list')}?case={case.pk}&all=1",
+                "resolve": reverse("incident-resolve", args=[0]),
+            },
+        },
+    }
+    return render(request, "cases/case_detail.html", context)
+
+
+@dataclass(frozen=True)
+class WorkRow:
+    task: str
+    label: str
+    state: str
+    who: str
+    job: str
+
+
+def work_row(item: WorkItem) -> WorkRow:
+    """An open work item as the page lists it (render.ts's workRow says it the same way)."""
+    job = getattr(item, "job", None)  # operator tasks have none
+    who = item.claimed_by.get_username() if item.claimed_by else ""
+    if not who and item.cobot is not None:
+        who = item.cobot.name
+    return WorkRow(item.task, item.label or item.task, item.state, who or "–", _job_text(item, job))
+
+
+def _job_text(item: WorkItem, job: Job | None) -> str:
+    if job is None:
+        return ""
+    position = getattr(item, "queue_position", None)  # annotated by the selector
+    if job.state == JobState.QUEUED:
+        text = f"queued, position {position}" if position is not None else "queued"
+        return f"{text}; waiting for {job.waiting_for}" if job.waiting_for else text
+    if job.state == JobState.RUNNING:
+        return f"running, attempt {job.attempt}"
+    return f"{job.state}: {job.last_error}" if job.last_error else str(job.state)
+
+
+def _supervised_case(request: HttpRequest, pk: int) -> Case:
+    """The case if the user may see it (else 404, as the API) and supervise it (else 403)."""
+    case = selectors.cases_visible_to(request.user).filter(pk=pk).first()
+    if case is None:
+        raise Http404("No such case.")
+    if not may_write_in(request.user, case.organisation_id):
+        raise Refused(403, SUPERVISORS_ONLY)
+    return case
+
+
+def _seq_param(request: HttpRequest, name: str) -> int | None:
+    value = request.GET.get(name)
+    if value is None:
+        return None
+    if not value.isascii() or not value.isdigit() or len(value) > 9:
+        raise Refused(400, f"{name} must be an event number (a whole number), not {value!r}.")
+    return int(value)
+
+
+def _drawn_tasks(
+    drawing: NetDrawing,
+    marking: Mapping[str, int],
+    items: Iterable[WorkItem],
+    incidents: Iterable[Incident],
+) -> list[DrawnTask]:
+    offered = {
+        item.task for item in items if item.state in {WorkItemState.OFFERED, WorkItemState.CLAIMED}
+    }
+    troubled = {
+        incident.work_item.task
+        for incident in incidents
+        if incident.resolved_at is None and incident.work_item is not None
+    }
+    drawn = []
+    for node in drawing.transitions:
+        if node.id in troubled:
+            state = "incident"
+        elif marking.get(f"running:{node.id}", 0) > 0:
+            state = "running"
+        elif node.id in offered:
+            state = "offered"
+        else:
+            state = ""
+        drawn.append(DrawnTask(node, state))
+    return drawn
+
+
+def _timeline_page(
+    case: Case, before: int | None, labels: Mapping[str, str]
+) -> tuple[list[TimelineRow], int | None]:
+    """The page of events before `before` (the newest when None), newest first, and the
+    `before` of the next older page (None on the first event's page)."""
+    events = selectors.events_of(case)
+    if before is not None:
+        events = events.filter(seq__lt=before)
+    page = list(events.order_by("-seq")[:EVENTS_PER_PAGE])
+    older = page[-1].seq if page and page[-1].seq > 1 else None
+    return [timeline_row(event, labels) for event in page], older
+
+
+def timeline_row(event: CaseEvent, labels: Mapping[str, str]) -> TimelineRow:
+    return TimelineRow(
+        seq=event.seq,
+        at=event.at,
+        who=event.user.get_username() if event.user else (event.actor or "hrc"),
+        what=EVENT_NAMES.get(event.type, event.type),
+        type=event.type,
+        task=event.task,
+        task_label=labels.get(event.task, event.task),
+        change=marking_change(event.marking_before, event.marking_after),
+        detail=", ".join(f"{key}: {_short(value)}" for key, value in event.detail.items()),
+    )
+
+
+def marking_change(before: Mapping[str, int], after: Mapping[str, int]) -> list[str]:
+    """What an event did to the marking, place by place: ["p1 −1", "running:to1 +1"]."""
+    changes = []
+    for place in sorted(set(before) | set(after)):
+        delta = after.get(place, 0) - before.get(place, 0)
+        if delta:
+            changes.append(f"{place} {'+' if delta > 0 else '−'}{abs(delta)}")
+    return changes
+
+
+def _short(value: Any) -> str:
+    text = value if isinstance(value, str) else json.dumps(value, sort_keys=True)
+    return text if len(text) <= 80 else text[:79] + "…"
+
+
+def _interruption_rows(interruptions: Iterable[Interruption]) -> list[InterruptionRow]:
+    now = timezone.now()
+    return [
+        InterruptionRow(i, ((i.ended_at or now) - i.started_at).total_seconds(), i.ended_at is None)
+        for i in interruptions
+    ]
+
+
+def format_duration(seconds: float) -> str:
+    """12.3 s, 4 min 05 s, 2 h 03 min."""
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    whole = int(seconds)
+    if whole < 3600:
+        return f"{whole // 60} min {whole % 60:02d} s"
+    return f"{whole // 3600} h {whole % 3600 // 60:02d} min"
+
+
+# Open incidents ----------------------------------------------------------------------------
+
+
+@login_required
+def incident_list(request: HttpRequest) -> HttpResponse:
+    """The unresolved incidents of the user's organisations' cases, newest first."""
+    try:
+        _require_supervisor(request)
+    except Refused as refused:
+        return _refusal(request, refused)
+    incidents = selectors.supervised_incidents(request.user)
+    page = Paginator(incidents, INCIDENTS_PER_PAGE).get_page(request.GET.get("page"))
+    script = {
+        "page": "incidents",
+        "api": {
+            "incidents": reverse("incident-list"),
+            "resolve": reverse("incident-resolve", args=[0]),
+            "case": reverse("cases:case-detail", args=[0]),
+        },
+        "live": page.number == 1,
+    }
+    context = {"page": page, "script": script, "section": "incidents"}
+    return render(request, "cases/incident_list.html", context)
