@@ -13,13 +13,13 @@ from typing import Any
 import psycopg
 import pytest
 
-from bench.runtime import (
+from bench.runtime import parse_args
+from bench.runtime_rig import (
     QUICK,
     ROOT,
     Settings,
     database_server,
     loop_pattern,
-    parse_args,
     signal_pattern,
 )
 from hrc.engine import check_document

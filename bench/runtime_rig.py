@@ -1,0 +1,484 @@
+"""The case runtime bench's rig: what its measurements share (bench/runtime.py runs them).
+
+A scratch PostgreSQL database, a private redis-server, real Celery workers,
+simulated OPC UA gateways at time scale 0, the API served over HTTP from a
+thread, an OPC UA observer, and the bare Celery app whose worker is the
+dispatch floor. Nothing at module level imports Django or hrc: the floor
+worker imports this module.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import http.client
+import json
+import os
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Self
+from urllib.parse import urlsplit, urlunsplit
+
+from celery import Celery
+
+from bench.handshake import percentile
+
+if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the functions
+    from django.contrib.auth.models import User
+
+    from hrc.cases.launcher import RedisProcess, WorkerProcess
+    from hrc.cobots.gateway.launcher import GatewayProcess
+    from hrc.cobots.models import Cobot
+    from hrc.patterns.models import PatternVersion
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS_DIR = ROOT / "bench" / "results"
+TARGET_P50_MS, TARGET_P99_MS, TARGET_CASES_PER_SECOND = 10.0, 50.0, 250.0
+SETTINGS_MODULE = "hrc.settings.test"  # dev's DEBUG would keep every query in memory
+DEFAULT_DATABASE_SERVER = "postgres://postgres@127.0.0.1:5432"
+PROGRAM, STEP = "Coexistence_PickAndPlace", 3  # step 3, "pick": a 2 s wait, zero at time scale 0
+FLOOR_REGISTER, FLOOR_VALUES_FROM = "Int29", 1_000_000  # an input no handshake writes
+# An operator is never as quick as the bench: give the worker the moment it
+# needs to answer the doorbell its own finish rang before the next step starts.
+SETTLE_SECONDS = 0.01
+
+# The Celery floor: a bare app configured as hrc's (acks late, prefetch 1; its
+# worker prefork, concurrency 1) whose one task hands back, through Redis, the
+# wall-clock time its first line ran at. Its worker imports this module, which
+# is why nothing at module level imports Django or hrc.
+FLOOR_BROKER_ENV, FLOOR_QUEUE = "HRC_BENCH_FLOOR_BROKER", "bench-floor"
+floor_app = Celery("hrc-bench-floor", broker=os.environ.get(FLOOR_BROKER_ENV, "memory://"))
+floor_app.conf.update(
+    task_acks_late=True, worker_prefetch_multiplier=1, task_default_queue=FLOOR_QUEUE
+)
+_floor_redis: Any = None
+
+
+# Celery ships no type hints (pyproject.toml says the same for hrc's tasks).
+@floor_app.task(name="bench.runtime.note_start", ignore_result=True)  # type: ignore[untyped-decorator]
+def note_start(key: str) -> None:
+    """Pushes time.time() of the task's first line onto the list `key` of the broker's Redis."""
+    started = time.time()
+    global _floor_redis
+    if _floor_redis is None:
+        import redis
+
+        _floor_redis = redis.Redis.from_url(os.environ[FLOOR_BROKER_ENV])
+    _floor_redis.rpush(key, repr(started))
+
+
+# The patterns and the settings ------------------------------------------------------------
+
+SIGNAL_SHAPE = "p1 → to1 (operator) → p2 → tc1 (cobot: Coexistence_PickAndPlace step 3) → p3"
+LOOP_SHAPE = (
+    "p0 → begin → p1 → to1 (operator) → p2 → again [data.again] → p1 | done [not data.again] "
+    "→ p3 → tc1 (cobot) → p4; the cases keep data.again true"
+)
+
+
+def _document(
+    name: str, places: str, transitions: list[dict[str, Any]], arcs: str
+) -> dict[str, Any]:
+    """One process, operator o and cobot c; `arcs` as "a>b b>c …"."""
+    first, *rest = places.split()
+    process = {
+        "id": "N",
+        "workpiece": "w",
+        "actors": ["c", "o"],
+        "places": [{"id": first, "tokens": 1}, *({"id": p} for p in rest)],
+        "transitions": transitions,
+        "arcs": [arc.split(">") for arc in arcs.split()],
+    }
+    actors = [{"id": "c", "type": "cobot", "program": PROGRAM}, {"id": "o", "type": "operator"}]
+    return {"format": "hrc-pattern/1", "name": name, "actors": actors, "processes": [process]}
+
+
+def _tasks() -> list[dict[str, Any]]:
+    step = {"step": {"program": PROGRAM, "number": STEP}}
+    return [
+        {"id": "to1", "performer": "o", "label": "place part"},
+        {"id": "tc1", "performer": "c", "label": "pick", "task": step},
+    ]
+
+
+def signal_pattern() -> dict[str, Any]:
+    """The smallest publishable pattern with one cobot task: every actor must perform a task,
+    so an operator task comes first (SIGNAL_SHAPE)."""
+    return _document("bench: operator, cobot", "p1 p2 p3", _tasks(), "p1>to1 to1>p2 p2>tc1 tc1>p3")
+
+
+def loop_pattern() -> dict[str, Any]:
+    """The operator task again and again while data.again holds (LOOP_SHAPE)."""
+    silent = [
+        {"id": "begin"},
+        {"id": "again", "guard": "data.again"},
+        {"id": "done", "guard": "not data.again"},
+    ]
+    arcs = "p0>begin begin>p1 p1>to1 to1>p2 p2>again again>p1 p2>done done>p3 p3>tc1 tc1>p4"
+    return _document("bench: operator loop", "p0 p1 p2 p3 p4", _tasks() + silent, arcs)
+
+
+@dataclass(frozen=True)
+class Settings:
+    steps: int = 500  # (a) timed steps
+    warmup: int = 50  # (a) untimed steps first, and untimed floor samples
+    floor_samples: int = 1000  # (a) timed samples of each floor
+    cases: int = 1000  # (b) cases per row
+    cobots: int = 4  # (b) simulated cobots, one job queue each
+    workers: tuple[int, ...] = (1, 2)  # (b) one row per worker count
+    repeats: int = 50  # (c) timed steps in each case length
+    events: int = 1000  # (c) the long case's log
+    quick: bool = False
+    results_dir: Path = field(default=RESULTS_DIR, compare=False)
+
+
+QUICK: dict[str, Any] = {
+    "steps": 20,
+    "warmup": 5,
+    "floor_samples": 100,
+    "cases": 40,
+    "cobots": 2,
+    "repeats": 10,
+}
+
+
+def summary(values_ms: Sequence[float]) -> dict[str, float]:
+    ordered = list(values_ms)
+    return {
+        "n": len(ordered),
+        **{
+            f"{name}_ms": round(percentile(ordered, q), 3)
+            for name, q in (("p50", 0.5), ("p99", 0.99))
+        },
+        "mean_ms": round(statistics.fmean(ordered), 3),
+        "min_ms": round(min(ordered), 3),
+        "max_ms": round(max(ordered), 3),
+    }
+
+
+# The machinery: database, observer, HTTP, the floor worker ----------------------------------
+
+
+def database_server() -> str:
+    """DATABASE_URL's PostgreSQL server (without its database), or the local default."""
+    parts = urlsplit(os.environ.get("DATABASE_URL", ""))
+    if parts.scheme not in ("postgres", "postgresql") or not parts.netloc:
+        return DEFAULT_DATABASE_SERVER
+    return urlunsplit((parts.scheme, parts.netloc, "", "", ""))
+
+
+@contextlib.contextmanager
+def scratch_database(server: str) -> Iterator[str]:
+    """Creates hrc_bench_<pid> on `server` and yields its URL; drops it, sessions and all."""
+    import psycopg
+
+    name = f"hrc_bench_{os.getpid()}"
+
+    def admin(statement: str) -> None:
+        with psycopg.connect(f"{server}/postgres", autocommit=True) as connection:
+            connection.execute(statement)
+
+    admin(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+    admin(f'CREATE DATABASE "{name}"')
+    try:
+        yield f"{server}/{name}"
+    finally:
+        admin(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+
+
+class Observer:
+    """An OPC UA client of one gateway, on its own thread, noting when input registers change.
+
+    It subscribes as the driver does (publishing interval 0, sampling 0) and
+    keeps the perf_counter() of the first notification of each (register,
+    value): it sees a written value when and as the cobot's program would.
+    """
+
+    def __init__(self, endpoint: str, cobot: str, registers: Sequence[str]) -> None:
+        self.endpoint, self.cobot, self.registers = endpoint, cobot, tuple(registers)
+        self._loop = asyncio.new_event_loop()
+        self._thread = threading.Thread(target=self._loop.run_forever, daemon=True)
+        self._seen: dict[tuple[str, Any], float] = {}
+        self._names: dict[Any, str] = {}
+        self._changed = threading.Condition()
+        self._client: Any = None
+
+    def start(self) -> Self:
+        self._thread.start()
+        asyncio.run_coroutine_threadsafe(self._connect(), self._loop).result(30)
+        return self
+
+    async def _connect(self) -> None:
+        from asyncua import Client, ua
+
+        from hrc.cobots import urua
+
+        self._client = Client(self.endpoint)
+        await self._client.connect()
+        nodes = [
+            self._client.get_node(urua.node_id(self.cobot, urua.register_path("Inputs", name)))
+            for name in self.registers
+        ]
+        self._names = {node.nodeid: name for node, name in zip(nodes, self.registers, strict=True)}
+        # The heartbeat too: asyncua recreates a subscription quiet for a second,
+        # and a notification could fall into the gap.
+        nodes.append(self._client.get_node(urua.node_id(self.cobot, urua.STATE_HEARTBEAT)))
+        parameters = ua.CreateSubscriptionParameters(
+            RequestedPublishingInterval=0,
+            RequestedLifetimeCount=300,
+            RequestedMaxKeepAliveCount=100,
+            PublishingEnabled=True,
+        )
+        subscription = await self._client.create_subscription(parameters, self)
+        await subscription.subscribe_data_change(nodes, queuesize=16, sampling_interval=0)
+
+    def datachange_notification(self, node: Any, value: Any, data: Any) -> None:
+        now = time.perf_counter()
+        register = self._names.get(node.nodeid)
+        if register is not None:  # not the heartbeat
+            with self._changed:
+                self._seen.setdefault((register, value), now)
+                self._changed.notify_all()
+
+    def status_change_notification(self, status: Any) -> None:
+        pass  # the gateway went away: seen_at times out and says so
+
+    def seen_at(self, register: str, value: int, timeout: float = 30.0) -> float:
+        """perf_counter() when `register` first held `value`; TimeoutError when it never did."""
+        with self._changed:
+            if not self._changed.wait_for(lambda: (register, value) in self._seen, timeout):
+                raise TimeoutError(f"{self.cobot}: {register} never became {value}")
+            return self._seen[(register, value)]
+
+    def close(self) -> None:
+        if self._client is not None:
+            future = asyncio.run_coroutine_threadsafe(self._client.disconnect(), self._loop)
+            with contextlib.suppress(Exception):
+                future.result(10)
+        self._loop.call_soon_threadsafe(self._loop.stop)
+        self._thread.join(10)
+
+
+class ApiServer:
+    """Django's WSGI application on 127.0.0.1 (wsgiref, one thread) and a JSON client for it."""
+
+    def __init__(self) -> None:
+        from wsgiref.simple_server import WSGIRequestHandler, make_server
+
+        from django.core.wsgi import get_wsgi_application
+
+        class Quiet(WSGIRequestHandler):
+            def log_message(self, format: str, *args: Any) -> None:
+                pass  # a line per request would bury the table
+
+        self._server = make_server("127.0.0.1", 0, get_wsgi_application(), handler_class=Quiet)
+        self._thread = threading.Thread(target=self._server.serve_forever, daemon=True)
+
+    def start(self) -> Self:
+        self._thread.start()
+        return self
+
+    def connect(self) -> http.client.HTTPConnection:
+        """An open connection, so that a timed request does not pay for the TCP handshake."""
+        connection = http.client.HTTPConnection("127.0.0.1", self._server.server_port, timeout=30)
+        connection.connect()
+        return connection
+
+    def post(
+        self, path: str, body: Mapping[str, Any], token: str = "", connection: Any = None
+    ) -> tuple[int, Any]:
+        connection = connection or self.connect()
+        headers = {"Content-Type": "application/json"}
+        if token:
+            headers["Authorization"] = f"Token {token}"
+        try:
+            connection.request("POST", path, json.dumps(body), headers)
+            response = connection.getresponse()
+            return response.status, json.loads(response.read() or b"null")
+        finally:
+            connection.close()
+
+    def stop(self) -> None:
+        self._server.shutdown()
+        self._server.server_close()
+
+
+class FloorWorker:
+    """`celery -A bench.runtime_rig:floor_app worker` with hrc's worker options, in its own group."""
+
+    def __init__(self, workdir: Path, broker: str) -> None:
+        self.broker, self.log = broker, workdir / "floor-worker.log"
+        self.process: subprocess.Popen[bytes] | None = None
+
+    def start(self, timeout: float = 60.0) -> Self:
+        command = [sys.executable, "-m", "celery", "-A", "bench.runtime_rig:floor_app", "worker",
+                   "--hostname", "floor@%h", "--pool", "prefork", "--concurrency", "1",
+                   "--loglevel", "INFO", "--without-gossip", "--without-mingle",
+                   "--without-heartbeat", "--queues", FLOOR_QUEUE]  # fmt: skip
+        with self.log.open("ab") as log:
+            self.process = subprocess.Popen(
+                command,
+                cwd=ROOT,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env={**os.environ, FLOOR_BROKER_ENV: self.broker, "PYTHONUNBUFFERED": "1"},
+                start_new_session=True,
+            )
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and self.process.poll() is None:
+            if " ready." in self.log.read_text(errors="replace"):
+                return self
+            time.sleep(0.05)
+        self.stop()
+        raise RuntimeError(f"The floor worker did not start:\n{self.log.read_text()[-4000:]}")
+
+    def stop(self) -> None:
+        if self.process is not None and self.process.poll() is None:
+            os.killpg(self.process.pid, signal.SIGTERM)
+            try:
+                self.process.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.process.pid, signal.SIGKILL)
+                self.process.wait(10)
+        self.process = None
+
+
+# The rig: everything the measurements share ---------------------------------------------------
+
+
+@dataclass
+class Rig:
+    workdir: Path
+    database_url: str
+    redis: RedisProcess
+    operator: User
+    token: str
+    signal: PatternVersion
+    loop: PatternVersion
+    cobots: list[Cobot]
+    gateways: list[GatewayProcess]
+    api: ApiServer
+    workers: list[WorkerProcess] = field(default_factory=list)
+
+    def use_workers(self, count: int) -> None:
+        """Exactly `count` workers running; the first runs the beat that runs the sweeper."""
+        from hrc.cases.launcher import WorkerProcess
+
+        while len(self.workers) > count:
+            self.workers.pop().stop()
+        environment = {
+            "DJANGO_SETTINGS_MODULE": SETTINGS_MODULE,
+            "DATABASE_URL": self.database_url,
+            "REDIS_URL": self.redis.url,
+            "HRC_SWEEP_SECONDS": "0.5",
+            "HRC_RETRY_BACKOFF": "0.2",
+        }
+        while len(self.workers) < count:
+            name, first = f"worker{len(self.workers)}", not self.workers
+            worker = WorkerProcess(self.workdir, name=name, environment=environment, beat=first)
+            self.workers.append(worker.start())
+
+    def worker_nodes(self) -> list[str]:
+        return [f"{worker.name}@{socket.gethostname()}" for worker in self.workers]
+
+
+@contextlib.contextmanager
+def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
+    from hrc.cases.launcher import RedisProcess
+
+    with contextlib.ExitStack() as stack:
+        workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="hrc-bench-")))
+        redis = RedisProcess(workdir).start()
+        stack.callback(redis.stop)
+        database_url = stack.enter_context(scratch_database(database_server()))
+        progress(f"scratch database {database_url.rsplit('/', 1)[1]}, broker {redis.url}")
+        _set_up_django(database_url, redis.url)
+        stack.callback(_close_connections)
+        gateways: list[GatewayProcess] = []
+        stack.callback(_stop_all, gateways)
+        made = _populate(workdir, settings.cobots, gateways)
+        api = ApiServer().start()
+        stack.callback(api.stop)
+        status, body = api.post("/api/token/", made.pop("credentials"))
+        if status != 200:
+            raise RuntimeError(f"POST /api/token/ answered {status}: {body}")
+        bench = Rig(
+            workdir, database_url, redis, token=body["token"], api=api, gateways=gateways, **made
+        )
+        stack.callback(bench.use_workers, 0)
+        yield bench
+
+
+def _stop_all(processes: Sequence[GatewayProcess]) -> None:
+    for process in processes:
+        process.stop()
+
+
+def _set_up_django(database_url: str, redis_url: str) -> None:
+    os.environ.update(
+        DJANGO_SETTINGS_MODULE=SETTINGS_MODULE, DATABASE_URL=database_url, REDIS_URL=redis_url
+    )
+    import django
+
+    django.setup()
+    from django.core.management import call_command
+
+    # Loads hrc's Celery app, as Django projects do at start-up: without it a
+    # shared task sent from this process would go to Celery's default app.
+    import hrc.celery  # noqa: F401
+
+    call_command("migrate", verbosity=0, interactive=False)
+
+
+def _close_connections() -> None:
+    from django.db import connections
+
+    connections.close_all()
+
+
+def _populate(workdir: Path, cobots: int, gateways: list[GatewayProcess]) -> dict[str, Any]:
+    """An organisation with an engineer and an operator, the cobots, the two patterns published."""
+    from django.contrib.auth.models import User
+
+    from hrc.cases import services
+    from hrc.cobots.drivers.runner import driver_for
+    from hrc.cobots.gateway.launcher import GatewayProcess
+    from hrc.cobots.models import Cobot
+    from hrc.organisations import services as organisations
+    from hrc.organisations.choices import Role
+    from hrc.patterns import services as patterns
+
+    organisation = organisations.create_organisation(name="Bench plant", slug="bench-plant")
+    engineer = User.objects.create_user("bench-engineer")
+    organisations.add_member(organisation, engineer, Role.ENGINEER)
+    credentials = {"username": "bench-operator", "password": uuid.uuid4().hex}
+    operator = User.objects.create_user(**credentials)
+    organisations.add_member(organisation, operator, Role.OPERATOR)
+    made: list[Cobot] = []
+    for number in range(1, cobots + 1):
+        name = f"cobot{number}"
+        gateway = GatewayProcess(name, workdir / f"{name}.json", time_scale=0.0)
+        gateways.append(gateway.start())
+        driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
+        driver.call("PowerOn", timeout=30)
+        driver.call("SelectProgram", PROGRAM)
+        driver.call("StartProgram")
+        driver.close()  # this process drives no cobot during the run
+        made.append(Cobot.objects.create(organisation=organisation, name=name, endpoint=gateway.endpoint))  # fmt: skip
+    versions = {}
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": made[0].pk}}
+    for key, document in (("signal", signal_pattern()), ("loop", loop_pattern())):
+        draft = patterns.create_pattern(organisation, name=document["name"], created_by=engineer, draft=document)  # fmt: skip
+        versions[key] = patterns.publish_pattern(draft, published_by=engineer)
+        services.set_default_actor_mapping(versions[key], mapping)
+    return {"operator": operator, "credentials": credentials, "cobots": made, **versions}
