@@ -404,14 +404,18 @@ def _complete_held_steps(case: Case, net: CaseNet) -> bool:
     if not net.holdable_tasks:
         return False  # no constraint can hold a completion: nothing is ever held
     done = False
-    held = WorkItem.objects.filter(
-        case=case, task__in=net.holdable_tasks, state=WorkItemState.RUNNING,
-        job__state=JobState.SUCCEEDED,
-    ).select_related("job")  # fmt: skip
+    undecided = Incident.objects.filter(work_item=OuterRef("pk"), resolved_at__isnull=True)
+    held = (
+        WorkItem.objects.filter(
+            case=case, task__in=net.holdable_tasks, state=WorkItemState.RUNNING,
+            job__state=JobState.SUCCEEDED,
+        )
+        .exclude(Exists(undecided))  # outputs that did not map wait for a person
+        .select_related("job")
+    )  # fmt: skip
     for item in held:
         if net.can_complete(Marking(case.marking), item.task):
-            _complete(case, net, item, item.job.result or {}, None)
-            done = True
+            done = _complete_step(case, net, item, item.job.result or {}) or done
     return done
 
 
@@ -535,8 +539,25 @@ def complete_cobot_task(
     Call while holding the case row lock, with the item running; the caller saves the case.
     """
     if net.can_complete(Marking(case.marking), item.task):
-        _complete(case, net, item, result, None)
+        _complete_step(case, net, item, result)
     advance(case, net)
+
+
+def _complete_step(case: Case, net: CaseNet, item: WorkItem, result: Mapping[str, Any]) -> bool:
+    """Completes a cobot task whose step is done; an incident when its outputs do not map.
+
+    The step ran and is not sent again: a person skips the task with the
+    outputs it should have given, or cancels the case.
+    """
+    try:
+        _complete(case, net, item, result, None)
+    except Invalid as fault:
+        open_incident(
+            case, IncidentKind.CASE_FAULT,
+            f"{item.label} ran, but its outputs cannot go into the case data: {fault}", item=item,
+        )  # fmt: skip
+        return False
+    return True
 
 
 def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:

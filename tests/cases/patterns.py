@@ -110,3 +110,12 @@ def shared_space(mode: str = "pause") -> dict[str, Any]:
     return _document(
         "Shared space", _process(tasks, arcs, [f"p{i}" for i in range(7)]), [constraint]
     )
+
+
+def unusable_outputs() -> dict[str, Any]:
+    """One cobot step (after the operator's to1) whose output expression reads a key no step
+    result has: the step runs, its outputs cannot go into the case data."""
+    document = cobot_chain(steps=1)
+    task = document["processes"][0]["transitions"][1]["task"]
+    task["outputs"] = {"grip": "result.grip_force"}
+    return document

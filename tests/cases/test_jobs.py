@@ -15,7 +15,7 @@ from hrc.cases.choices import CaseStatus, IncidentKind, JobState, WorkItemState
 from hrc.cases.models import Case, Incident, Interruption, Job, WorkItem
 from hrc.cases.simulation import Simulation
 from hrc.cobots import urua
-from tests.cases.patterns import scan_until_found, shared_space
+from tests.cases.patterns import scan_until_found, shared_space, unusable_outputs
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
@@ -133,3 +133,29 @@ def _unlocked(cobot: Any) -> bool:
     except Exception:
         return False  # too soon after the stop: a UR controller waits too
     return True
+
+
+@pytest.mark.parametrize("simulation", [(unusable_outputs(), 0.0)], indirect=True)
+def test_a_step_whose_outputs_do_not_map_is_an_incident_not_a_stuck_job(
+    simulation: Simulation,
+) -> None:
+    with simulation.running(operators=False):
+        [case_id] = simulation.start_cases(1)
+        case = Case.objects.get(pk=case_id)
+        services.complete_work_item(_do(simulation, case, "to1"), user=simulation.users["o"])
+        incident = until(lambda: Incident.objects.filter(case=case).first())
+        assert incident.kind == IncidentKind.CASE_FAULT
+        assert "grip" in incident.message
+        job = Job.objects.get(case=case)
+        assert job.state == JobState.SUCCEEDED  # the step ran once and is not sent again
+
+        # The person gives the result the step should have answered; it maps as usual.
+        services.resolve_incident(
+            incident, by=simulation.users["o"], resolution="skip", outputs={"grip_force": 12.5}
+        )
+        assert simulation.wait([case_id], timeout=30)
+
+    case.refresh_from_db()
+    assert case.status == CaseStatus.COMPLETED
+    assert case.data["grip"] == 12.5
+    assert simulation.executed_steps("c")[0] == 1
