@@ -6,6 +6,8 @@ job that is due from the rows themselves. So a failed send is logged, not raised
 
 `run_inline` swaps Celery for a thread pool in this process (run_pattern
 without workers, and the embedded demo); everything else stays the same.
+The embedded demo has no Celery beat either: `start_embedded_sweeper` runs
+the sweeper on a thread of the server instead.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import functools
 import logging
 import threading
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, ThreadPoolExecutor
 from contextlib import contextmanager
@@ -35,7 +38,10 @@ def _send(task_name: str, args: tuple[Any, ...], countdown: float) -> None:
     from hrc.cases import tasks  # the tasks module imports the services that import this one
 
     task = getattr(tasks, task_name)
-    executor = _inline or (_embedded_pool() if settings.HRC_INLINE_TASKS else None)
+    executor = _inline
+    if executor is None and settings.HRC_INLINE_TASKS:
+        executor = _embedded_pool()
+        start_embedded_sweeper()
     if executor is not None:
         _submit_inline(executor, task.run, args, countdown)
         return
@@ -68,6 +74,26 @@ def _submit_inline(
 @functools.cache
 def _embedded_pool() -> Executor:
     return ThreadPoolExecutor(max_workers=4, thread_name_prefix="hrc-jobs")
+
+
+@functools.cache
+def start_embedded_sweeper() -> threading.Thread:
+    """Runs the sweeper every HRC_SWEEP_SECONDS on the embedded pool, for the life of the process.
+
+    Without it a job whose doorbell was lost (the server stopped mid-case)
+    would wait forever. Once per process; the server calls it at start-up.
+    """
+    from hrc.cases import tasks
+
+    def ring() -> None:
+        while True:
+            time.sleep(settings.HRC_SWEEP_SECONDS)
+            if settings.HRC_INLINE_TASKS:  # settings can change under tests
+                _submit_inline(_embedded_pool(), tasks.sweep.run, (), 0)
+
+    thread = threading.Thread(target=ring, name="hrc-sweeper", daemon=True)
+    thread.start()
+    return thread
 
 
 @contextmanager
