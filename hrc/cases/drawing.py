@@ -1,10 +1,10 @@
 """A published pattern drawn for the supervisor pages: where each place, task, arc and constraint goes.
 
 Positions are the document's own `layout` keys (centre coordinates on every
-place and transition, lanes per actor on the document), as the editor and
-the engine's auto-layout write them. A document without them (published
-before layouts existed, or written by hand) gets a plain column layout here,
-good enough to read a marking on; it is not the editor's layout.
+place and transition, lanes per actor on the document), as the editor writes
+them. A document without them (published before layouts existed, imported,
+written by hand) is laid out by the engine (hrc.engine.layout), in the same
+actor lanes the editor would show.
 
 The drawing is geometry only; the template turns it into SVG and the page's
 script (frontend/src/supervisor/) puts the live marking on it.
@@ -13,21 +13,20 @@ script (frontend/src/supervisor/) puts the live marking on it.
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, Literal
 
 from hrc.engine.execution import constraint_places
+from hrc.engine.layout import SIZES, lay_out_pattern
 from hrc.engine.model import Pattern, Process
 
-PLACE_RADIUS = 18.0
-TASK_SIZE = (112.0, 44.0)
-SILENT_SIZE = (12.0, 44.0)  # a routing step (split, join) is a bar
-MARGIN = 48.0
-# The fallback layout's grid.
-COLUMN_STEP = 150.0
-ROW_STEP = 90.0
+# The sizes the engine's layout leaves room for.
+PLACE_RADIUS = SIZES["place"][0] / 2
+TASK_SIZE = SIZES["task"]
+SILENT_SIZE = SIZES["silent"]  # a routing step (split, join) is a bar
+MARGIN = 30.0
+LINE_CHARACTERS = 15  # of a task's label at the page's font size, in a task's width
 
 NodeKind = Literal["place", "task", "silent"]
 
@@ -59,9 +58,20 @@ class Node:
         return self.half[1] * 2
 
     @property
-    def short_label(self) -> str:
-        """The label cut to fit a task's box (the full one is the SVG title)."""
-        return self.label if len(self.label) <= 16 else self.label[:15] + "…"
+    def label_lines(self) -> list[str]:
+        """A task's label in at most two lines that fit its box (the full label is its title)."""
+        lines: list[str] = []
+        for word in self.label.split():
+            if lines and len(lines[-1]) + 1 + len(word) <= LINE_CHARACTERS:
+                lines[-1] += f" {word}"
+            else:
+                lines.append(word)
+        if len(lines) > 2:
+            lines = [lines[0], " ".join(lines[1:])]
+        return [
+            line if len(line) <= LINE_CHARACTERS else line[: LINE_CHARACTERS - 1] + "…"
+            for line in lines
+        ]
 
     def rim_towards(self, x: float, y: float) -> tuple[float, float]:
         """Where a line from the centre towards (x, y) leaves the node's shape."""
@@ -125,9 +135,11 @@ class NetDrawing:
 
 
 def draw_net(pattern: Pattern) -> NetDrawing:
-    """The pattern's drawing, from its layout keys where every node has one, else a column layout."""
-    written = _written_positions(pattern)
-    positions = written or _column_positions(pattern)
+    """The pattern's drawing, from its layout keys where every node has one, else the engine's."""
+    positions = _written_positions(pattern)
+    if positions is None:
+        pattern = lay_out_pattern(pattern)
+        positions = _written_positions(pattern) or {}
     nodes: dict[str, Node] = {}
     for process in pattern.processes:
         for place in process.places:
@@ -146,7 +158,7 @@ def draw_net(pattern: Pattern) -> NetDrawing:
         for source, target in process.arcs
     )
     constraints = tuple(_constraint_lines(pattern, nodes))
-    lanes = _written_lanes(pattern) if written else ()
+    lanes = _written_lanes(pattern)
     width, height = _extent(nodes.values(), pattern)
     return NetDrawing(
         width=width,
@@ -202,43 +214,10 @@ def _written_lanes(pattern: Pattern) -> tuple[Lane, ...]:
         if not isinstance(lane, Mapping):
             continue
         y, height = _number(lane.get("y")), _number(lane.get("height"))
-        if "actor" in lane and y is not None and height is not None:
-            drawn.append(Lane(str(lane["actor"]), y, height))
+        if y is not None and height is not None:
+            # The engine adds a lane with actor null for nodes of no declared actor.
+            drawn.append(Lane(str(lane.get("actor") or ""), y, height))
     return tuple(drawn)
-
-
-def _column_positions(pattern: Pattern) -> dict[str, tuple[float, float]]:
-    """Each node in the column of its distance from the process' source places; processes stacked."""
-    positions: dict[str, tuple[float, float]] = {}
-    top = MARGIN
-    for process in pattern.processes:
-        columns = _columns(process)
-        rows: dict[int, int] = {}
-        for node, column in columns.items():
-            row = rows.get(column, 0)
-            rows[column] = row + 1
-            positions[node] = (MARGIN + column * COLUMN_STEP, top + row * ROW_STEP)
-        top += max(rows.values(), default=1) * ROW_STEP
-    return positions
-
-
-def _columns(process: Process) -> dict[str, int]:
-    """Breadth-first distance from the source places; unreachable nodes after the rest."""
-    successors: dict[str, list[str]] = {}
-    for source, target in process.arcs:
-        successors.setdefault(source, []).append(target)
-    columns = {place: 0 for place in process.source_places()}
-    queue = deque(columns)
-    while queue:
-        node = queue.popleft()
-        for successor in successors.get(node, []):
-            if successor not in columns:
-                columns[successor] = columns[node] + 1
-                queue.append(successor)
-    last = max(columns.values(), default=-1)
-    for node_id, _ in _elements(process):
-        columns.setdefault(node_id, last + 1)
-    return columns
 
 
 def _arc(source: Node, target: Node) -> Arc:

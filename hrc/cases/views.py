@@ -15,6 +15,7 @@ import datetime as dt
 import json
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 from django.contrib.auth.decorators import login_required
@@ -37,6 +38,7 @@ from hrc.cases.drawing import ConstraintLine, NetDrawing, Node, draw_net
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
 from hrc.organisations.selectors import may_write_in, writable_organisations
+from hrc.patterns.models import PatternVersion
 
 CASES_PER_PAGE = 50
 INCIDENTS_PER_PAGE = 50
@@ -149,7 +151,7 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
         before = _seq_param(request, "before")
     except Refused as refused:
         return _refusal(request, refused)
-    drawing = draw_net(case_net(case.version).pattern)
+    drawing = _drawing(case.version.pk, case.version)
     items = list(
         selectors.work_items_visible_to(request.user).filter(
             case=case, state__in=sorted(OPEN_WORK_ITEM_STATES)
@@ -219,6 +221,12 @@ def _job_text(item: WorkItem, job: Job | None) -> str:
     if job.state == JobState.RUNNING:
         return f"running, attempt {job.attempt}"
     return f"{job.state}: {job.last_error}" if job.last_error else str(job.state)
+
+
+@lru_cache(maxsize=256)
+def _drawing(version_id: int, version: PatternVersion) -> NetDrawing:
+    # Keyed by id: a published version never changes, so neither does its drawing.
+    return draw_net(case_net(version).pattern)
 
 
 def _supervised_case(request: HttpRequest, pk: int) -> Case:

@@ -6,8 +6,9 @@ from typing import Any
 
 import pytest
 
-from hrc.cases.drawing import MARGIN, PLACE_RADIUS, TASK_SIZE, draw_net
+from hrc.cases.drawing import LINE_CHARACTERS, PLACE_RADIUS, TASK_SIZE, draw_net
 from hrc.engine.document import read_pattern
+from hrc.engine.layout import lay_out
 from tests import factories
 
 
@@ -44,7 +45,7 @@ def test_the_layout_keys_place_every_node_and_lane() -> None:
         ("o", 100, 100),
     ]
     assert drawing.width == 900  # the written size, where it holds every node
-    assert drawing.height == 150 + TASK_SIZE[1] / 2 + MARGIN  # grown to hold to1 and a margin
+    assert drawing.height == 150 + TASK_SIZE[1] / 2 + 30  # grown to hold to1 and a margin
 
 
 def test_an_arc_runs_from_rim_to_rim() -> None:
@@ -76,16 +77,23 @@ def test_a_func_constraint_has_both_of_its_places() -> None:
     assert sorted(line.places) == ["func-done:to1>tc1", "func-start:tc1>to1"]
 
 
-def test_a_document_without_layout_is_laid_out_in_columns_from_its_source() -> None:
+def test_a_document_without_layout_is_laid_out_by_the_engine_in_actor_lanes() -> None:
     document = _laid_out()
     del document["processes"][0]["places"][1]["layout"]  # one node without: none is trusted
     drawing = draw_net(read_pattern(document))
 
-    columns = {n.id: n.x for n in (*drawing.places, *drawing.transitions)}
-    assert columns["p1"] == MARGIN
-    assert columns["p1"] < columns["to1"] < columns["p2"] < columns["tc1"] < columns["p3"]
-    assert drawing.lanes == ()  # the document's lanes belong to its own positions
-    assert drawing.width >= columns["p3"] + PLACE_RADIUS
+    engine = lay_out(factories.valid_document())
+    expected = {
+        element["id"]: (element["layout"]["x"], element["layout"]["y"])
+        for element in (*engine["processes"][0]["places"], *engine["processes"][0]["transitions"])
+    }
+    assert {n.id: (n.x, n.y) for n in (*drawing.places, *drawing.transitions)} == expected
+    lanes = {lane.actor: lane for lane in drawing.lanes}
+    assert sorted(lanes) == ["c", "o"]
+    for task in drawing.transitions:
+        lane = lanes[task.actor]
+        assert lane.y <= task.y <= lane.y + lane.height, task.id
+    assert drawing.width >= max(n.x for n in drawing.places) + PLACE_RADIUS
 
 
 @pytest.mark.parametrize("bad", [{"x": "10", "y": 5}, {"x": True, "y": 5}, {"y": 5}, None, [1, 2]])
@@ -93,20 +101,20 @@ def test_a_layout_key_that_is_not_two_numbers_is_not_trusted(bad: Any) -> None:
     document = _laid_out()
     document["processes"][0]["transitions"][0]["layout"] = copy.deepcopy(bad)
     drawing = draw_net(read_pattern(document))
-    assert next(n for n in drawing.places if n.id == "p1").x == MARGIN  # the column layout
+    assert next(n for n in drawing.places if n.id == "p1").x != 60  # the engine's layout
 
 
-def test_a_coexistence_pattern_stacks_its_processes() -> None:
-    process = factories.valid_document()["processes"][0]
-    second = copy.deepcopy(process)
-    second["id"] = "M"
-    for element in (*second["places"], *second["transitions"]):
-        element["id"] += "b"
-    second["arcs"] = [[a + "b", b + "b"] for a, b in second["arcs"]]
-    document = factories.valid_document()
-    document["processes"].append(second)
-    document["constraints"] = []
+def test_an_unknown_actor_lane_is_drawn_without_a_name() -> None:
+    document = _laid_out()
+    document["layout"]["lanes"].append({"actor": None, "y": 200, "height": 50})
+    assert draw_net(read_pattern(document)).lanes[-1].actor == ""
 
-    drawing = draw_net(read_pattern(document))
-    y = {n.id: n.y for n in drawing.places}
-    assert y["p1b"] > y["p1"]
+
+def test_a_label_is_cut_into_two_lines_that_fit_a_task() -> None:
+    document = _laid_out()
+    document["processes"][0]["transitions"][0]["label"] = (
+        "check and fine-polish the first polished line"
+    )
+    [to1] = [n for n in draw_net(read_pattern(document)).transitions if n.id == "to1"]
+    assert to1.label_lines == ["check and", "fine-polish th…"]
+    assert all(len(line) <= LINE_CHARACTERS for line in to1.label_lines)

@@ -8,15 +8,18 @@ the rest: the live marking and resolving incidents.
 
 import datetime as dt
 import re
+from pathlib import Path
 
 import pytest
+from django.conf import settings
 from django.contrib.auth.models import User
+from django.db.models import TextChoices
 from django.test import Client
 from django.utils import timezone
 from pytest_django import DjangoAssertNumQueries
 
 from hrc.cases import services
-from hrc.cases.choices import CaseStatus, InterruptionMode
+from hrc.cases.choices import CaseStatus, EventType, IncidentKind, InterruptionMode
 from hrc.cases.models import Case, Incident, Interruption
 from hrc.cases.views import EVENTS_PER_PAGE, format_duration, marking_change
 from hrc.cobots.models import Cobot
@@ -58,6 +61,7 @@ def incident(step_case: Case) -> Incident:
 
 
 PAGES = ["/cases/", "/incidents/"]
+SCRIPT = Path(settings.BASE_DIR) / "frontend" / "src" / "supervisor"
 
 
 # Who may look ------------------------------------------------------------------------------
@@ -348,6 +352,23 @@ def test_the_incidents_page_lists_open_incidents_with_their_case(
     assert incident.case.version.pattern.name in card
     assert f'data-incident="{other.pk}"' not in page
     assert 'id="supervisor-page"' in page
+
+
+# The page script --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("table", "choices"),
+    [("EVENT_NAMES", EventType), ("INCIDENT_KINDS", IncidentKind), ("CASE_STATUSES", CaseStatus)],
+)
+def test_the_page_script_names_things_as_the_server_does(
+    table: str, choices: type[TextChoices]
+) -> None:
+    source = (SCRIPT / "model.ts").read_text()
+    body = re.search(rf"export const {table}: Record<string, string> = {{(.*?)}};", source, re.S)
+    assert body, table
+    pairs = re.findall(r'"?([a-z-]+)"?: "([^"]+)"', body.group(1))
+    assert dict(pairs) == dict(choices.choices)
 
 
 # Helpers -----------------------------------------------------------------------------------

@@ -1,0 +1,237 @@
+// Pure functions of the supervisor pages: what the marking, the open work and the event
+// log mean on the page. The server renders the first view with the same rules
+// (hrc/cases/views.py); these keep it up to date.
+
+import type { CaseJson, EventJson, IncidentJson, JobJson, Marking, WorkItemJson } from "./api";
+
+export type TaskState = "incident" | "running" | "offered" | "";
+
+/** A place's tokens as drawn: nothing, one dot, or the number. */
+export function tokenText(tokens: number): string {
+  if (tokens <= 0) return "";
+  return tokens === 1 ? "●" : String(tokens);
+}
+
+/** The tokens in a constraint's places (a time constraint's completions not yet used, …). */
+export function constraintTokens(places: readonly string[], marking: Marking): number {
+  return places.reduce((sum, place) => sum + (marking[place] ?? 0), 0);
+}
+
+/**
+ * How each task is drawn: an open incident about it first, then running (its `running:`
+ * place holds a token), then offered (an open work item nobody has started).
+ */
+export function taskStates(
+  tasks: readonly string[],
+  marking: Marking,
+  items: readonly WorkItemJson[],
+  openIncidents: readonly IncidentJson[],
+): Map<string, TaskState> {
+  const troubled = new Set(openIncidents.map((incident) => incident.task).filter(Boolean));
+  const offered = new Set(
+    items.filter((item) => item.state === "offered" || item.state === "claimed").map((i) => i.task),
+  );
+  const states = new Map<string, TaskState>();
+  for (const task of tasks) {
+    if (troubled.has(task)) states.set(task, "incident");
+    else if ((marking[`running:${task}`] ?? 0) > 0) states.set(task, "running");
+    else if (offered.has(task)) states.set(task, "offered");
+    else states.set(task, "");
+  }
+  return states;
+}
+
+/** What an event did to the marking, place by place: ["p1 −1", "running:to1 +1"]. */
+export function markingChange(before: Marking, after: Marking): string[] {
+  const places = [...new Set([...Object.keys(before), ...Object.keys(after)])].sort();
+  const changes: string[] = [];
+  for (const place of places) {
+    const delta = (after[place] ?? 0) - (before[place] ?? 0);
+    if (delta) changes.push(`${place} ${delta > 0 ? "+" : "−"}${Math.abs(delta)}`);
+  }
+  return changes;
+}
+
+/** An ISO time as the pages print it, in UTC (the server's time zone): 2025-01-31 13:05:09. */
+export function formatTime(iso: string): string {
+  const at = new Date(iso);
+  if (Number.isNaN(at.getTime())) return iso;
+  return at.toISOString().slice(0, 19).replace("T", " ");
+}
+
+export interface TimelineRow {
+  seq: number;
+  at: string;
+  when: string;
+  who: string;
+  what: string;
+  type: string;
+  task: string;
+  taskLabel: string;
+  change: string;
+  detail: string;
+}
+
+export const EVENT_NAMES: Record<string, string> = {
+  "case-started": "Case started",
+  "case-suspended": "Case suspended",
+  "case-resumed": "Case resumed",
+  "case-cancelled": "Case cancelled",
+  "case-completed": "Case completed",
+  "case-failed": "Case failed",
+  "task-offered": "Task offered",
+  "task-claimed": "Task claimed",
+  "task-unclaimed": "Task unclaimed",
+  "task-started": "Task started",
+  "task-completed": "Task completed",
+  "task-withdrawn": "Task withdrawn",
+  "task-interrupted": "Task interrupted",
+  "task-resumed": "Task resumed",
+  "transition-fired": "Transition fired",
+  "message-received": "Message received",
+  "step-retry": "Step will be retried",
+  "incident-opened": "Incident opened",
+  "incident-resolved": "Incident resolved",
+};
+
+function short(value: unknown): string {
+  const text = typeof value === "string" ? value : JSON.stringify(sortKeys(value));
+  return text.length <= 80 ? text : `${text.slice(0, 79)}…`;
+}
+
+function sortKeys(value: unknown): unknown {
+  if (Array.isArray(value)) return value.map(sortKeys);
+  if (value && typeof value === "object") {
+    const entries = Object.entries(value as Record<string, unknown>).sort(([a], [b]) =>
+      a < b ? -1 : a > b ? 1 : 0,
+    );
+    return Object.fromEntries(entries.map(([key, item]) => [key, sortKeys(item)]));
+  }
+  return value;
+}
+
+/** An event as a timeline row: who (the user, else the pattern actor, else hrc), what, when. */
+export function timelineRow(event: EventJson, labels: Record<string, string>): TimelineRow {
+  return {
+    seq: event.seq,
+    at: event.at,
+    when: formatTime(event.at),
+    who: event.user || event.actor || "hrc",
+    what: EVENT_NAMES[event.type] ?? event.type,
+    type: event.type,
+    task: event.task,
+    taskLabel: labels[event.task] ?? event.task,
+    change: markingChange(event.marking_before, event.marking_after).join(", "),
+    detail: Object.entries(event.detail)
+      .map(([key, value]) => `${key}: ${short(value)}`)
+      .join(", "),
+  };
+}
+
+/** The events not shown yet (seq after `lastSeq`), oldest first, each once. */
+export function unseenEvents(lastSeq: number, events: readonly EventJson[]): EventJson[] {
+  const bySeq = new Map<number, EventJson>();
+  for (const event of events) if (event.seq > lastSeq) bySeq.set(event.seq, event);
+  return [...bySeq.values()].sort((a, b) => a.seq - b.seq);
+}
+
+/** Whether these events change what the interruptions table shows. */
+export function touchesInterruptions(events: readonly EventJson[]): boolean {
+  return events.some((e) => e.type === "task-interrupted" || e.type === "task-resumed");
+}
+
+export interface WorkRow {
+  task: string;
+  label: string;
+  state: string;
+  who: string;
+  job: string;
+}
+
+function jobText(job: JobJson | null): string {
+  if (!job) return "";
+  if (job.state === "queued") {
+    const text = job.queue_position === null ? "queued" : `queued, position ${job.queue_position}`;
+    return job.waiting_for ? `${text}; waiting for ${job.waiting_for}` : text;
+  }
+  if (job.state === "running") return `running, attempt ${job.attempt}`;
+  return job.last_error ? `${job.state}: ${job.last_error}` : job.state;
+}
+
+/** An open work item as the page lists it (views.work_row says it the same way). */
+export function workRow(item: WorkItemJson): WorkRow {
+  return {
+    task: item.task,
+    label: item.label || item.task,
+    state: item.state,
+    who: item.claimed_by || item.job?.cobot_name || "–",
+    job: jobText(item.job),
+  };
+}
+
+export type Resolution = "retry" | "skip" | "cancel";
+
+export type Checked<T> = { ok: true; value: T } | { ok: false; message: string };
+
+export interface ResolveBody {
+  resolution: Resolution;
+  again?: boolean;
+  outputs?: Record<string, unknown>;
+}
+
+/**
+ * The body of a resolve request, or why it cannot be sent: skip's outputs must be a JSON
+ * object (the task's result); retry's `again` asks for a new attempt of a step.
+ */
+export function resolveBody(
+  resolution: Resolution,
+  options: { again: boolean; outputs: string },
+): Checked<ResolveBody> {
+  if (resolution === "retry") return { ok: true, value: { resolution, again: options.again } };
+  if (resolution === "cancel") return { ok: true, value: { resolution } };
+  const text = options.outputs.trim() || "{}";
+  let outputs: unknown;
+  try {
+    outputs = JSON.parse(text);
+  } catch (error) {
+    const reason = error instanceof Error ? error.message : String(error);
+    return { ok: false, message: `The outputs are not JSON: ${reason}` };
+  }
+  if (!outputs || typeof outputs !== "object" || Array.isArray(outputs)) {
+    return { ok: false, message: 'The outputs must be a JSON object, such as {"placed": true}.' };
+  }
+  return { ok: true, value: { resolution, outputs: outputs as Record<string, unknown> } };
+}
+
+/** What a resolved incident card says: "Resolved: skip by erik-engineer". */
+export function outcomeText(incident: IncidentJson): string {
+  if (!incident.resolved_at) return "";
+  const by = incident.resolved_by ? ` by ${incident.resolved_by}` : "";
+  return `Resolved: ${incident.resolution}${by}`;
+}
+
+/** Incidents whose kind the page names (hrc/cases/choices.py IncidentKind). */
+export const INCIDENT_KINDS: Record<string, string> = {
+  "step-failed": "Cobot step failed",
+  "device-failed": "Device call failed",
+  "lease-expired": "Worker lost the job repeatedly",
+  "case-fault": "Case fault",
+};
+
+export const CASE_STATUSES: Record<string, string> = {
+  running: "Running",
+  suspended: "Suspended",
+  completed: "Completed",
+  cancelled: "Cancelled",
+  failed: "Failed",
+};
+
+/** The open incidents of a case as its detail carries them. */
+export function openIncidents(caseJson: CaseJson): IncidentJson[] {
+  return caseJson.incidents.filter((incident) => !incident.resolved_at);
+}
+
+/** JSON as the page shows it: indented, keys sorted (as the server's pretty_json). */
+export function prettyJson(value: unknown): string {
+  return JSON.stringify(sortKeys(value), null, 2);
+}
