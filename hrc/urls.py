@@ -9,6 +9,8 @@ from rest_framework.authtoken.views import obtain_auth_token
 urlpatterns = [
     path("", TemplateView.as_view(template_name="home.html"), name="home"),
     path("admin/", admin.site.urls),
+    # The operators' tablets (hrc.live).
+    path("", include("hrc.live.urls")),
     path("", include("hrc.cases.urls")),  # the supervisor pages: /cases/, /incidents/
     # Sign-in, sign-out and password change for the tablets and the editor.
     path("accounts/", include("django.contrib.auth.urls")),

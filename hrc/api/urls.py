@@ -7,4 +7,5 @@ urlpatterns = [
     path("", include("hrc.patterns.api.urls")),
     path("", include("hrc.cobots.api.urls")),
     path("", include("hrc.cases.api.urls")),
+    path("", include("hrc.live.api.urls")),
 ]

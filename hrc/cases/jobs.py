@@ -51,6 +51,7 @@ from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet
+from hrc.live import broadcast as live
 
 logger = logging.getLogger(__name__)
 
@@ -109,6 +110,8 @@ def lease_next_job(cobot_id: int) -> Lease | None:
         )  # the lock and both reasons to wait in one query
         if cobot.busy or cobot.paused:
             return None
+        if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.live.services)
+            return None
         queued = Job.objects.filter(
             cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
             case__status=CaseStatus.RUNNING,
@@ -133,6 +136,7 @@ def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -
         if job.waiting_for != waiting:
             job.waiting_for = waiting
             job.save(update_fields=["waiting_for"])
+            live.cobot_queue_on_commit(cobot.pk)
         return None
     if item.state == WorkItemState.OFFERED:
         services.start_cobot_task(case, net, item)
@@ -142,6 +146,7 @@ def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -
     job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
     job.save(update_fields=LEASED_FIELDS)
     case.save()
+    live.cobot_queue_on_commit(cobot.pk)
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
         sent_before=job.sent_at is not None,
@@ -380,6 +385,7 @@ def _expire_lease(job_id: int, case_id: int) -> None:
             job.state, job.next_try_at = JobState.QUEUED, timezone.now()
             job.save()
         case.save()
+        live.cobot_queue_on_commit(job.cobot_id)
         dispatch.send_on_commit("run_job", job.pk)
 
 
@@ -434,6 +440,7 @@ def resume_cobot(interruption_id: int) -> None:
             cobot=interruption.cobot, ended_at__isnull=True, paused_at__isnull=False
         ).exclude(pk=interruption.pk)
         needed = interruption.paused_at is not None and not others.exists()
+        needed = needed and interruption.cobot.stopped_at is None  # a STOP's resume restarts it
         if needed and not _command(interruption, pause=False):
             return
         interruption.resumed_at = timezone.now()

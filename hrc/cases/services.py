@@ -41,6 +41,7 @@ from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, resolve
 from hrc.engine.taskconfig import POSE_LENGTH, TaskConfig
+from hrc.live import broadcast as live
 from hrc.patterns.models import PatternVersion
 
 # advance() repeats settle → messages → held completions until nothing changes;
@@ -692,6 +693,7 @@ def record_event(
     Call while holding the case row lock; the caller saves the case (its last_seq).
     """
     case.last_seq += 1
+    live.case_event_on_commit(case, event, item, user, detail)  # the tablets, after commit
     marking = dict(case.marking)
     return CaseEvent.objects.create(
         case=case, seq=case.last_seq, at=timezone.now(), type=event,

@@ -31,7 +31,7 @@ class CobotAdmin(CobotAdminBase):
     list_select_related = ["organisation"]
     readonly_fields = ["created_at", "updated_at"]
     fieldsets = [
-        (None, {"fields": ["organisation", "name", "is_active"]}),
+        (None, {"fields": ["organisation", "name", "cell", "is_active"]}),
         ("Connection", {"fields": ["driver", "endpoint", "credentials_source"]}),
         ("History", {"fields": ["created_at", "updated_at"]}),
     ]

@@ -7,7 +7,7 @@ worker reads them at connect time, so a database dump leaks no secrets.
 from django.db import models
 
 from hrc.cobots.choices import DriverKind
-from hrc.cobots.validators import validate_credentials_source, validate_endpoint
+from hrc.cobots.validators import validate_cell, validate_credentials_source, validate_endpoint
 from hrc.organisations.models import Organisation
 
 
@@ -41,6 +41,22 @@ class Cobot(models.Model):
             "Where the driver reads the credentials: 'none', 'env:VARIABLE_NAME' (an environment "
             "variable of the worker) or 'file:/run/secrets/name'. Never type the secret itself here."
         ),
+    )
+    cell = models.CharField(
+        max_length=50,
+        blank=True,
+        default="",
+        validators=[validate_cell],
+        help_text=(
+            "The work cell the cobot stands in (letters, digits, - and _); a tablet at /tablet/<cell>/ "
+            "shows and stops its cobots. Empty: the organisation's whole floor (/tablet/)."
+        ),
+    )
+    stopped_at = models.DateTimeField(
+        null=True,
+        blank=True,
+        editable=False,
+        help_text="Set while a tablet's STOP holds the cobot paused (hrc.live.services); no job starts.",
     )
     is_active = models.BooleanField(
         default=True,

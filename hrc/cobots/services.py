@@ -9,7 +9,7 @@ from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 
 # The fields a caller may set; organisation is fixed once the cobot exists.
-EDITABLE_FIELDS = ("name", "driver", "endpoint", "credentials_source", "is_active")
+EDITABLE_FIELDS = ("name", "driver", "endpoint", "credentials_source", "cell", "is_active")
 
 
 def create_cobot(organisation: Organisation, **fields: Any) -> Cobot:

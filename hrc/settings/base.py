@@ -35,6 +35,7 @@ INSTALLED_APPS = [
     "hrc.patterns",
     "hrc.cobots",
     "hrc.cases",
+    "hrc.live",
 ]
 
 MIDDLEWARE = [

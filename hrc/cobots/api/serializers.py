@@ -21,11 +21,13 @@ class CobotSerializer(serializers.ModelSerializer[Cobot]):
             "driver",
             "endpoint",
             "credentials_source",
+            "cell",
             "is_active",
+            "stopped_at",
             "created_at",
             "updated_at",
         ]
-        read_only_fields = ["id", "created_at", "updated_at"]
+        read_only_fields = ["id", "stopped_at", "created_at", "updated_at"]
         # The (organisation, name) constraint is checked by the service, after the
         # organisation is known; DRF's validator would need the organisation in the body.
         validators: list[object] = []

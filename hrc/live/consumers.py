@@ -1,0 +1,178 @@
+"""The tablets' WebSocket: /ws/live/?organisation=<id>&cell=<cell>. Thin: the rules live in
+selectors (who may watch, the snapshot) and broadcast (the deltas).
+
+On connect: refused (a `refused` event, then close 4401/4403) unless the
+session's user is a member of the organisation; then the socket joins its
+groups and only then reads the snapshot (hrc.live.events explains why). Each
+event type has its handler; every send first re-checks that the event is the
+organisation's and the cell's, and that the user is still a member (read
+again when the last check is older than RECHECK_SECONDS). `cobot-state`
+deltas are coalesced: at most one frame per STATE_INTERVAL per socket.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from typing import Any
+from urllib.parse import parse_qs
+
+from channels.db import database_sync_to_async
+from channels.generic.websocket import AsyncJsonWebsocketConsumer
+
+from hrc.cobots.validators import validate_cell
+from hrc.live import broadcast, selectors
+from hrc.live.events import CobotStateData, LiveEvent
+from hrc.live.selectors import Access
+
+# Seconds a membership check stays good before the next send reads it again.
+RECHECK_SECONDS = 5.0
+# At most 10 cobot-state frames a second per tablet.
+STATE_INTERVAL = 0.1
+UNAUTHENTICATED = 4401
+FORBIDDEN = 4403
+
+
+class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # channels is untyped
+    access: Access | None = None
+    cell: str = ""
+    groups_joined: list[str]
+
+    async def connect(self) -> None:
+        broadcast.server_loop = asyncio.get_running_loop()
+        self.groups_joined = []
+        self._states: dict[int, CobotStateData] = {}
+        self._state_flush: asyncio.TimerHandle | None = None
+        self._last_state_frame = 0.0
+        await self.accept()
+        user = self.scope.get("user")
+        if user is None or not user.is_authenticated:
+            await self._refuse("Sign in first.", UNAUTHENTICATED)
+            return
+        try:
+            organisation, self.cell = _parameters(self.scope.get("query_string", b""))
+        except ValueError as error:
+            await self._refuse(str(error), FORBIDDEN)
+            return
+        self.access = await database_sync_to_async(selectors.access_of)(user, organisation)
+        if self.access is None:
+            await self._refuse("You are not a member of this organisation.", FORBIDDEN)
+            return
+        self._checked_at = time.monotonic()
+        access = self.access
+        self.groups_joined = [
+            broadcast.organisation_group(access.organisation_id),
+            broadcast.user_group(access.user_id),
+            broadcast.cell_group(access.organisation_id, self.cell),
+        ]
+        for group in self.groups_joined:
+            await self.channel_layer.group_add(group, self.channel_name)
+        await self._send_snapshot()
+
+    async def disconnect(self, code: int) -> None:
+        if self._state_flush is not None:
+            self._state_flush.cancel()
+        for group in self.groups_joined:
+            await self.channel_layer.group_discard(group, self.channel_name)
+
+    async def receive_json(self, content: Any, **kwargs: Any) -> None:
+        """The client asks for one thing: a new snapshot, after a hole in a case's numbers."""
+        if isinstance(content, dict) and content.get("type") == "resync" and self.access:
+            await self._send_snapshot()
+
+    # The channel layer's message, then one handler per event type ------------------------
+
+    async def live_event(self, message: dict[str, Any]) -> None:
+        event = message["event"]
+        if not await self._may_see(message):
+            return
+        handler = self._HANDLERS.get(event.get("type"))
+        if handler is not None:
+            await handler(self, event)
+
+    async def on_case(self, event: LiveEvent) -> None:
+        await self.send_json(event)
+
+    async def on_work_item(self, event: LiveEvent) -> None:
+        await self.send_json(event)
+
+    async def on_incident(self, event: LiveEvent) -> None:
+        await self.send_json(event)
+
+    async def on_cobot_queue(self, event: LiveEvent) -> None:
+        await self.send_json(event)
+
+    async def on_cell_stop(self, event: LiveEvent) -> None:
+        await self.send_json(event)
+
+    async def on_cobot_state(self, event: LiveEvent) -> None:
+        for state in event["states"]:  # type: ignore[typeddict-item]
+            self._states[state["cobot"]] = state
+        if self._state_flush is None:
+            wait = max(0.0, self._last_state_frame + STATE_INTERVAL - time.monotonic())
+            self._state_flush = asyncio.get_running_loop().call_later(
+                wait, lambda: asyncio.ensure_future(self._flush_states())
+            )
+
+    _HANDLERS = {
+        "case": on_case,
+        "work-item": on_work_item,
+        "incident": on_incident,
+        "cobot-queue": on_cobot_queue,
+        "cell-stop": on_cell_stop,
+        "cobot-state": on_cobot_state,
+    }
+
+    # Helpers ------------------------------------------------------------------------------
+
+    async def _flush_states(self) -> None:
+        self._state_flush = None
+        states, self._states = list(self._states.values()), {}
+        if states and self.access is not None and await self._still_member():
+            self._last_state_frame = time.monotonic()
+            await self.send_json({"type": "cobot-state", "states": states})
+
+    async def _may_see(self, message: dict[str, Any]) -> bool:
+        """The event is this organisation's (and this cell's), and the user is still a member."""
+        access = self.access
+        if access is None or message.get("organisation") != access.organisation_id:
+            return False
+        cell = message.get("cell", "")
+        if self.cell and cell != self.cell and message["event"].get("type") != "cell-stop":
+            return False
+        return await self._still_member()
+
+    async def _still_member(self) -> bool:
+        assert self.access is not None
+        if time.monotonic() - self._checked_at < RECHECK_SECONDS:
+            return True
+        if await database_sync_to_async(selectors.still_member)(self.access):
+            self._checked_at = time.monotonic()
+            return True
+        await self._refuse("You are no longer a member of this organisation.", FORBIDDEN)
+        return False
+
+    async def _send_snapshot(self) -> None:
+        assert self.access is not None
+        snapshot = await database_sync_to_async(selectors.snapshot)(self.access, self.cell)
+        self._checked_at = time.monotonic()
+        await self.send_json(snapshot)
+
+    async def _refuse(self, reason: str, code: int) -> None:
+        self.access = None
+        await self.send_json({"type": "refused", "reason": reason})
+        await self.close(code=code)
+
+
+def _parameters(query_string: bytes) -> tuple[int | None, str]:
+    """(organisation id or None, cell) from the query string; ValueError naming what is wrong."""
+    query = parse_qs(query_string.decode("latin-1"))
+    raw = (query.get("organisation") or [""])[0]
+    if raw and not raw.isdigit():
+        raise ValueError(f"organisation must be an id (a whole number), not {raw!r}.")
+    cell = (query.get("cell") or [""])[0]
+    try:
+        validate_cell(cell)
+    except Exception:
+        raise ValueError(f"{cell!r} is not a cell name.") from None
+    return (int(raw) if raw else None), cell

@@ -1,0 +1,252 @@
+"""Reads for the tablets: who may watch what, the snapshot, and cobot queues.
+
+The snapshot is built from the same rules as the deltas (hrc.live.broadcast
+builds both kinds of payload), so that applying a tablet's deltas to an old
+snapshot gives the fresh one; tests/live/test_event_stream.py checks it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from django.db.models import F
+from django.db.models.fields.json import KeyTextTransform
+
+from hrc.cases.choices import OPEN_CASE_STATUSES, OPEN_WORK_ITEM_STATES, JobState
+from hrc.cases.models import Case, Incident, Job, WorkItem
+from hrc.cobots.models import Cobot
+from hrc.live import cobot_states
+from hrc.live.broadcast import candidates_of, cobots_of_mapping, now
+from hrc.live.events import (
+    CaseData,
+    CellStopData,
+    CobotData,
+    CobotQueueData,
+    CurrentStep,
+    IncidentData,
+    Snapshot,
+    WorkItemData,
+)
+from hrc.live.models import CellStop
+from hrc.organisations.models import Membership, Team
+from hrc.organisations.selectors import AnyUser
+
+
+@dataclass(frozen=True)
+class Access:
+    """What a socket's user is in the organisation it watches."""
+
+    user_id: int
+    username: str
+    organisation_id: int
+    role: str
+
+
+def access_of(user: AnyUser, organisation_id: int | None) -> Access | None:
+    """The user's access to the organisation; None for a non-member (or an anonymous user).
+
+    With no organisation given, the user's only one (or the first by name).
+    """
+    if not user.is_authenticated or not user.is_active:
+        return None
+    memberships = Membership.objects.filter(user_id=user.pk).order_by("organisation__name")
+    if organisation_id is not None:
+        memberships = memberships.filter(organisation_id=organisation_id)
+    found = memberships.values_list("organisation_id", "role").first()
+    if found is None:
+        return None
+    return Access(user.pk, user.get_username(), found[0], found[1])
+
+
+def still_member(access: Access) -> bool:
+    return Membership.objects.filter(
+        user_id=access.user_id, organisation_id=access.organisation_id, user__is_active=True
+    ).exists()
+
+
+def snapshot(access: Access, cell: str) -> Snapshot:
+    """Everything a tablet shows, as of now. Cases are read first: a change that lands while
+    the rest is read is then newer than the case's seq, and its delta is applied on top."""
+    organisation = access.organisation_id
+    cases, mappings = _open_cases(organisation)
+    case_ids = [case["id"] for case in cases]
+    cobots = Cobot.objects.filter(organisation_id=organisation).order_by("name")
+    if cell:
+        cobots = cobots.filter(cell=cell)
+    cobot_rows = list(cobots.values("id", "name", "cell", "stopped_at"))
+    ids = [row["id"] for row in cobot_rows]
+    queues = {data["cobot"]: data for _, _, data in cobot_queues(ids)}
+    states = cobot_states.recall(ids)
+    teams = Team.objects.filter(
+        organisation_id=organisation, members__user_id=access.user_id
+    ).values_list("pk", flat=True)
+    return {
+        "type": "snapshot",
+        "organisation": organisation,
+        "cell": cell,
+        "user": {
+            "id": access.user_id,
+            "username": access.username,
+            "role": access.role,
+            "teams": sorted(teams),
+        },
+        "cases": cases,
+        "work_items": _open_work_items(case_ids, mappings),
+        "incidents": _open_incidents(case_ids),
+        "cobots": [
+            CobotData(
+                id=row["id"],
+                name=row["name"],
+                cell=row["cell"],
+                stopped=row["stopped_at"] is not None,
+                state=states.get(row["id"]),
+                queue=queues[row["id"]],
+            )
+            for row in cobot_rows
+        ],
+        "stop": active_stop(organisation, cell),
+    }
+
+
+def _open_cases(organisation: int) -> tuple[list[CaseData], dict[int, Any]]:
+    """The organisation's open cases, and each one's actor mapping."""
+    rows = list(
+        Case.objects.filter(organisation_id=organisation, status__in=sorted(OPEN_CASE_STATUSES))
+        .annotate(name=KeyTextTransform("name", "version__document"))
+        .order_by("id")
+        .values("id", "last_seq", "status", "name", "actor_mapping")
+    )
+    cases: list[CaseData] = [
+        {
+            "id": row["id"],
+            "seq": row["last_seq"],
+            "status": row["status"],
+            "name": row["name"] or "",
+            "cobots": cobots_of_mapping(row["actor_mapping"]),
+        }
+        for row in rows
+    ]
+    return cases, {row["id"]: row["actor_mapping"] for row in rows}
+
+
+def _open_work_items(case_ids: list[int], mappings: dict[int, Any]) -> list[WorkItemData]:
+    rows = (
+        WorkItem.objects.filter(case_id__in=case_ids, state__in=sorted(OPEN_WORK_ITEM_STATES))
+        .order_by("offered_at", "id")
+        .values(
+            "id", "case_id", "task", "label", "actor", "kind", "state", "instructions",
+            "team_id", "cobot_id", "claimed_by_id", "offered_at", "started_at",
+        )
+    )  # fmt: skip
+    return [
+        {
+            "id": row["id"],
+            "case": row["case_id"],
+            "task": row["task"],
+            "label": row["label"],
+            "actor": row["actor"],
+            "kind": row["kind"],
+            "state": row["state"],
+            "instructions": row["instructions"],
+            "team": row["team_id"],
+            "cobot": row["cobot_id"],
+            "candidates": candidates_of(mappings.get(row["case_id"]), row["actor"])
+            if row["kind"] == "operator"
+            else [],
+            "claimed_by": row["claimed_by_id"],
+            "offered_at": row["offered_at"].isoformat(),
+            "started_at": row["started_at"].isoformat() if row["started_at"] else None,
+        }
+        for row in rows
+    ]
+
+
+def _open_incidents(case_ids: list[int]) -> list[IncidentData]:
+    rows = (
+        Incident.objects.filter(case_id__in=case_ids, resolved_at__isnull=True)
+        .order_by("id")
+        .values("id", "case_id", "work_item_id", "kind", "message", "resolution")
+    )
+    return [
+        {
+            "id": row["id"],
+            "case": row["case_id"],
+            "work_item": row["work_item_id"],
+            "kind": row["kind"],
+            "message": row["message"],
+            "resolution": row["resolution"],
+        }
+        for row in rows
+    ]
+
+
+def cobot_queues(cobot_ids: list[int]) -> list[tuple[int, str, CobotQueueData]]:
+    """(organisation, cell, queue) per cobot, in the order given: two queries whatever the count."""
+    cobots = {
+        row["id"]: row
+        for row in Cobot.objects.filter(pk__in=cobot_ids).values("id", "organisation_id", "cell")
+    }
+    jobs = (
+        Job.objects.filter(cobot_id__in=cobot_ids, state__in=[JobState.QUEUED, JobState.RUNNING])
+        .order_by("queued_at", "id")
+        .values(
+            "cobot_id", "state", "case_id", "work_item_id", "kind", "attempt", "waiting_for",
+            "command", task=F("work_item__task"), label=F("work_item__label"),
+        )
+    )  # fmt: skip
+    length: dict[int, int] = {}
+    current: dict[int, CurrentStep] = {}
+    waiting: dict[int, str] = {}
+    for job in jobs:
+        cobot = job["cobot_id"]
+        length[cobot] = length.get(cobot, 0) + 1
+        if job["state"] == JobState.RUNNING:
+            number = (job["command"] or {}).get("number")
+            current[cobot] = {
+                "case": job["case_id"], "work_item": job["work_item_id"], "task": job["task"],
+                "label": job["label"], "kind": job["kind"],
+                "step": int(number) if isinstance(number, int) else None,
+                "attempt": job["attempt"],
+            }  # fmt: skip
+        elif cobot not in waiting and job["waiting_for"]:
+            waiting[cobot] = job["waiting_for"]
+    at = now()
+    return [
+        (
+            cobots[pk]["organisation_id"],
+            cobots[pk]["cell"],
+            {
+                "cobot": pk,
+                "at": at,
+                "queue_length": length.get(pk, 0),
+                "current": current.get(pk),
+                "waiting_for": waiting.get(pk, ""),
+            },
+        )
+        for pk in cobot_ids
+        if pk in cobots
+    ]
+
+
+def active_stop(organisation: int, cell: str) -> CellStopData | None:
+    """The STOP holding the cell, or the whole floor's when the cell has none."""
+    stops = CellStop.objects.filter(organisation_id=organisation, resumed_at__isnull=True)
+    stop = stops.filter(cell=cell).select_related("stopped_by", "resumed_by").first()
+    if stop is None and cell:
+        stop = stops.filter(cell="").select_related("stopped_by", "resumed_by").first()
+    return stop_data(stop) if stop is not None else None
+
+
+def stop_data(stop: CellStop) -> CellStopData:
+    return {
+        "id": stop.pk,
+        "cell": stop.cell,
+        "at": now(),
+        "stopped_by": stop.stopped_by.get_username() if stop.stopped_by else "",
+        "stopped_at": stop.stopped_at.isoformat(),
+        "resumed_by": stop.resumed_by.get_username() if stop.resumed_by else "",
+        "resumed_at": stop.resumed_at.isoformat() if stop.resumed_at else None,
+        "cobots": list(stop.cobots),
+        "problems": dict(stop.problems),
+    }

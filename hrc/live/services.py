@@ -1,0 +1,187 @@
+"""Every write of the live layer: a tablet's STOP of a cell, and the confirmed resume.
+
+STOP is a convenience, not a safety function: it pauses the programs of the
+cell's cobots (PauseProgram, what a space constraint's interruption sends)
+and holds their queues (Cobot.stopped_at: no job is leased meanwhile). It
+never powers anything off and never touches a protective or emergency stop;
+the robots' own safety systems stay in charge. Resuming needs an explicit
+confirmation and restarts only the programs that are paused and that no
+operator's interruption still holds.
+
+The cobot commands go out after the rows are committed, outside the
+transaction (a robot is not rolled back); what a cobot refused is recorded
+on the CellStop and shown on the tablets.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+
+from django.contrib.auth.models import User
+from django.db import IntegrityError, transaction
+from django.db.models import Q
+from django.utils import timezone
+
+from hrc.cases import dispatch
+from hrc.cases.choices import JobState
+from hrc.cases.models import Interruption, Job
+from hrc.cobots import urua
+from hrc.cobots.drivers.base import DriverError
+from hrc.cobots.models import Cobot
+from hrc.live import broadcast
+from hrc.live.models import CellStop
+from hrc.live.selectors import stop_data
+from hrc.organisations.models import Organisation
+
+# Seconds a cobot may take to answer PauseProgram or StartProgram.
+COMMAND_TIMEOUT = 5.0
+
+
+class StopError(Exception):
+    """A STOP or resume that cannot be done; `status` is the HTTP status the API answers."""
+
+    status = 409
+
+
+def stop_cell(organisation: Organisation, cell: str, *, by: User) -> CellStop:
+    """Holds every active cobot of the cell ("" the whole floor) and pauses its program.
+
+    A second STOP of a stopped cell returns the first one. The caller checks
+    that `by` is a member of the organisation.
+    """
+    with transaction.atomic():
+        existing = _active(organisation, cell)
+        if existing is not None:
+            return existing
+        cobots = _cell_cobots(organisation, cell)
+        try:
+            with transaction.atomic():
+                stop = CellStop.objects.create(
+                    organisation=organisation,
+                    cell=cell,
+                    stopped_by=by,
+                    cobots=[c.pk for c in cobots],
+                )
+        except IntegrityError:  # another tablet stopped it at the same moment
+            found = _active(organisation, cell)
+            assert found is not None
+            return found
+        now = timezone.now()
+        Cobot.objects.filter(pk__in=[c.pk for c in cobots]).update(stopped_at=now)
+        for cobot in cobots:
+            broadcast.cobot_queue_on_commit(cobot.pk)
+    stop.problems = _command_all(cobots, _pause)
+    stop.save(update_fields=["problems"])
+    _broadcast(stop)
+    return stop
+
+
+def resume_cell(organisation: Organisation, cell: str, *, by: User, confirmed: bool) -> CellStop:
+    """Ends the cell's STOP: releases the queues and restarts the programs it paused.
+
+    Raises StopError (400) without the confirmation, (409) when the cell is not stopped.
+    A cobot that a protective or emergency stop holds is left as it is, and said so.
+    """
+    if not confirmed:
+        error = StopError("Resuming the cell needs a confirmation (confirm: true).")
+        error.status = 400
+        raise error
+    with transaction.atomic():
+        stop = (
+            CellStop.objects.select_for_update()
+            .filter(organisation=organisation, cell=cell, resumed_at__isnull=True)
+            .first()
+        )
+        if stop is None:
+            raise StopError(f"{_name(cell)} is not stopped.")
+        stop.resumed_by, stop.resumed_at = by, timezone.now()
+        stop.save(update_fields=["resumed_by", "resumed_at"])
+        held = list(Cobot.objects.select_for_update().filter(pk__in=stop.cobots))
+        Cobot.objects.filter(pk__in=[c.pk for c in held]).update(stopped_at=None)
+        for cobot in held:
+            broadcast.cobot_queue_on_commit(cobot.pk)
+            first = (
+                Job.objects.filter(cobot=cobot, state=JobState.QUEUED)
+                .values_list("pk", flat=True)
+                .first()
+            )
+            if first is not None:
+                dispatch.send_on_commit("run_job", first)  # the queue waited for the resume
+    problems = _command_all(held, _restart)
+    stop.problems = {**stop.problems, **problems}
+    stop.save(update_fields=["problems"])
+    _broadcast(stop)
+    return stop
+
+
+def _active(organisation: Organisation, cell: str) -> CellStop | None:
+    return CellStop.objects.filter(
+        organisation=organisation, cell=cell, resumed_at__isnull=True
+    ).first()
+
+
+def _cell_cobots(organisation: Organisation, cell: str) -> list[Cobot]:
+    cobots = Cobot.objects.select_for_update().filter(organisation=organisation, is_active=True)
+    return list(cobots.filter(cell=cell) if cell else cobots)
+
+
+def _command_all(cobots: list[Cobot], command: Callable[[Cobot], str]) -> dict[str, str]:
+    """Runs `command` on every cobot at once; {cobot id: problem} for those that did not do it."""
+    if not cobots:
+        return {}
+    with ThreadPoolExecutor(max_workers=min(8, len(cobots))) as pool:
+        outcomes = list(pool.map(command, cobots))
+    return {str(c.pk): problem for c, problem in zip(cobots, outcomes, strict=True) if problem}
+
+
+def _pause(cobot: Cobot) -> str:
+    """ "" when the cobot's program is paused (or was not playing); otherwise why not."""
+    from hrc.cobots.drivers.runner import driver_for_cobot
+
+    try:
+        driver = driver_for_cobot(cobot, connect_timeout=COMMAND_TIMEOUT)
+        state = driver.state()
+        if state.get("ProgramState") != urua.PROGRAM_PLAYING:
+            return ""  # nothing moves under program control; the queue is held anyway
+        driver.call("PauseProgram", timeout=COMMAND_TIMEOUT)
+    except DriverError as error:
+        return f"not paused: {error}"
+    return ""
+
+
+def _restart(cobot: Cobot) -> str:
+    """Restarts a paused program unless an interruption or a safety stop still holds the cobot."""
+    from hrc.cobots.drivers.runner import driver_for_cobot
+
+    unsettled = Interruption.objects.filter(cobot=cobot).filter(
+        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
+    )
+    try:
+        if unsettled.exists():
+            return ""  # the operator in the shared area resumes it when done
+        driver = driver_for_cobot(cobot, connect_timeout=COMMAND_TIMEOUT)
+        state = driver.state()
+        if state.get("SafetyMode") not in urua.SAFETY_MODES_THAT_MOVE:
+            return f"not restarted: {state.get('SafetyMode')}; a person must clear it at the cell"
+        if state.get("ProgramState") != urua.PROGRAM_PAUSED:
+            return ""
+        driver.call("StartProgram", timeout=COMMAND_TIMEOUT)
+    except DriverError as error:
+        return f"not restarted: {error}"
+    return ""
+
+
+def _broadcast(stop: CellStop) -> None:
+    with transaction.atomic():  # send_event_on_commit waits for a commit
+        stop = CellStop.objects.select_related("stopped_by", "resumed_by").get(pk=stop.pk)
+        broadcast.send_event_on_commit(
+            [broadcast.organisation_group(stop.organisation_id)],
+            {"type": "cell-stop", "stop": stop_data(stop)},
+            organisation=stop.organisation_id,
+            cell=stop.cell,
+        )
+
+
+def _name(cell: str) -> str:
+    return f"Cell {cell}" if cell else "The floor"

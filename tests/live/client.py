@@ -1,0 +1,59 @@
+"""A tablet without a browser: a real WebSocket client (websockets) with the store's rules in Python.
+
+`Tablet.apply` follows frontend/src/live/store.ts; the event-stream test also
+replays the captured events through the TypeScript store itself (replay.py).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from typing import Any
+
+from websockets.asyncio.client import ClientConnection, connect
+
+from tests.live.server import LiveServer
+
+
+async def open_socket(
+    server: LiveServer, cookie: str | None, query: str = "", origin: str | None = None
+) -> ClientConnection:
+    headers = {"Origin": origin or server.url}
+    if cookie:
+        headers["Cookie"] = cookie
+    return await connect(f"{server.ws_url}/ws/live/{query}", additional_headers=headers)
+
+
+async def receive(socket: ClientConnection, timeout: float = 10.0) -> dict[str, Any]:
+    message: dict[str, Any] = json.loads(await asyncio.wait_for(socket.recv(), timeout))
+    return message
+
+
+async def receive_until(
+    socket: ClientConnection, condition: Any, timeout: float = 20.0, into: list[Any] | None = None
+) -> dict[str, Any]:
+    """Events until one satisfies `condition`; every one received goes to `into`."""
+    deadline = time.monotonic() + timeout
+    while True:
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            raise AssertionError("no such event in time")
+        event = await receive(socket, remaining)
+        if into is not None:
+            into.append(event)
+        if condition(event):
+            return event
+
+
+async def db(function: Any, *args: Any, **kwargs: Any) -> Any:
+    """Runs ORM code from an async test: in a thread of its own, its connection closed after."""
+    from django.db import connections
+
+    def run() -> Any:
+        try:
+            return function(*args, **kwargs)
+        finally:
+            connections.close_all()
+
+    return await asyncio.to_thread(run)

@@ -1,0 +1,85 @@
+"""A real ASGI server (daphne's runserver) on the test database, which a test may stop and start.
+
+The browser fixtures keep one for the whole session; the live tests need
+their own too: one on a private broker beside Celery workers, one that is
+stopped under connected tablets and started again on the same port.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Self
+
+from django.conf import settings
+from django.contrib.auth.models import User
+from django.db import connection
+from django.test import Client
+
+from hrc.cobots.gateway.launcher import free_port
+
+
+class LiveServer:
+    def __init__(self, log: Path, environment: Mapping[str, str] | None = None) -> None:
+        self.port = free_port()
+        self.log = log
+        self.environment = dict(environment or {})
+        self.process: subprocess.Popen[bytes] | None = None
+
+    @property
+    def url(self) -> str:
+        return f"http://127.0.0.1:{self.port}"
+
+    @property
+    def ws_url(self) -> str:
+        return f"ws://127.0.0.1:{self.port}"
+
+    def start(self, timeout: float = 30.0) -> Self:
+        database = connection.settings_dict
+        environment = {
+            **os.environ,
+            "DJANGO_SETTINGS_MODULE": "hrc.settings.test",
+            "DATABASE_URL": f"postgres://{database['USER']}@{database['HOST']}:{database['PORT']}/{database['NAME']}",
+            "DJANGO_ALLOW_ASYNC_UNSAFE": "",
+            "PYTHONUNBUFFERED": "1",
+            **self.environment,
+        }
+        with self.log.open("ab") as output:
+            self.process = subprocess.Popen(
+                [sys.executable, "manage.py", "runserver", "--noreload", "--insecure",
+                 f"127.0.0.1:{self.port}"],
+                cwd=settings.BASE_DIR, env=environment, stdout=output, stderr=subprocess.STDOUT,
+            )  # fmt: skip
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"the test server exited; its log:\n{self.log.read_text()}")
+            try:
+                urllib.request.urlopen(f"{self.url}/accounts/login/", timeout=1).close()
+                return self
+            except OSError:
+                time.sleep(0.1)
+        self.stop()
+        raise RuntimeError(f"the test server did not answer in time:\n{self.log.read_text()}")
+
+    def stop(self) -> None:
+        if self.process is not None and self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(10)
+        self.process = None
+
+
+def session_cookie(user: User) -> str:
+    """A signed-in session for `user` in the database the server reads, as a Cookie header."""
+    client = Client()
+    client.force_login(user)
+    return f"{settings.SESSION_COOKIE_NAME}={client.cookies[settings.SESSION_COOKIE_NAME].value}"
