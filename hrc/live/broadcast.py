@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from channels.layers import get_channel_layer
-from django.db import close_old_connections, transaction
+from django.db import connections, transaction
 
 from hrc.live.events import CaseData, IncidentData, LiveEvent, WorkItemData
 
@@ -275,7 +275,6 @@ class _Sender:
 def _queue_messages(cobot_ids: list[int]) -> list[_Send]:
     from hrc.live.selectors import cobot_queues
 
-    close_old_connections()  # this thread's connection, like a request's
     try:
         return [
             _Send(
@@ -290,7 +289,9 @@ def _queue_messages(cobot_ids: list[int]) -> list[_Send]:
             for organisation, cell, data in cobot_queues(cobot_ids)
         ]
     finally:
-        close_old_connections()
+        # This thread's connection: kept, it would hold the database open after the process's
+        # other work is done (and block dropping a test database).
+        connections.close_all()
 
 
 async def _group_send_all(sends: list[_Send]) -> None:

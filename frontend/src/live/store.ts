@@ -44,6 +44,8 @@ export class LiveStore {
   // Cases that ended, with their last seq: late deltas of theirs are old, not holes.
   private ended = new Map<number, number>();
   private listeners: Array<(event: LiveEvent) => void> = [];
+  // Held deltas that the last applied one let through, in order.
+  private followers: CaseStreamDelta[] = [];
 
   subscribe(listener: (event: LiveEvent) => void): () => void {
     this.listeners.push(listener);
@@ -58,8 +60,11 @@ export class LiveStore {
   }
 
   apply(event: LiveEvent): Outcome {
+    this.followers = [];
     const outcome = this.applyOne(event);
-    if (outcome === "applied") this.listeners.forEach((listener) => listener(event));
+    if (outcome === "applied") {
+      for (const applied of [event, ...this.followers]) this.listeners.forEach((listener) => listener(applied));
+    }
     return outcome;
   }
 
@@ -122,7 +127,7 @@ export class LiveStore {
       const following = waiting.get(seq)!;
       waiting.delete(seq);
       this.applyInOrder(following);
-      this.listeners.forEach((listener) => listener(following));
+      this.followers.push(following);
       seq += 1;
     }
     if (waiting && waiting.size === 0) this.held.delete(delta.case);

@@ -1,0 +1,291 @@
+// The operator tablet: live task cards, the cobot panel, display messages, STOP and resume.
+
+import "./tablet.css";
+import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
+import { type ConnectionStatus, LiveSocket } from "../live/socket";
+import { type LiveState, LiveStore } from "../live/store";
+import { ApiError, request } from "./api";
+import { type FormSchema, renderForm } from "./form";
+import { activity, cobotsOf, degrees, humanSafety, myTasks, nextAction, teamTasks } from "./view";
+
+interface Config {
+  organisation: number;
+  cell: string;
+  user: number;
+  socket: string;
+}
+
+const STATUS_TEXT: Record<ConnectionStatus, string> = {
+  connecting: "Connecting…",
+  live: "Live",
+  reconnecting: "Connection lost: reconnecting…",
+  refused: "Refused",
+};
+const MAX_MESSAGES = 20;
+
+const root = document.getElementById("tablet") as HTMLElement;
+const config = JSON.parse(document.getElementById("tablet-config")!.textContent!) as Config;
+const $ = <T extends HTMLElement>(selector: string): T => root.querySelector(selector) as T;
+
+const store = new LiveStore();
+const scheme = location.protocol === "https:" ? "wss:" : "ws:";
+const socket = new LiveSocket({
+  url: `${scheme}//${location.host}${config.socket}`,
+  store,
+  onStatus: showStatus,
+});
+const messages: Array<{ cobot: string; text: string; at: number }> = [];
+const lastDisplay = new Map<number, string>();
+let frame = 0;
+
+store.subscribe((event: LiveEvent) => {
+  if (event.type === "cobot-state" || event.type === "snapshot") collectMessages();
+  if (!frame) frame = requestAnimationFrame(render);
+});
+
+function showStatus(status: ConnectionStatus, detail: string): void {
+  root.dataset.status = status;
+  $(".connection").textContent = STATUS_TEXT[status] + (detail ? ` (${detail})` : "");
+}
+
+// Rendering -------------------------------------------------------------------------------
+
+function render(): void {
+  frame = 0;
+  const state = store.state;
+  if (!state) return;
+  renderCards($(".cards.mine"), myTasks(state), state, "Nothing for you right now.");
+  renderCards($(".cards.team"), teamTasks(state), state, "No open team tasks.");
+  renderCobots(state);
+  renderStop(state);
+  renderMessages();
+}
+
+function renderCards(container: HTMLElement, items: WorkItemData[], state: LiveState, empty: string): void {
+  if (!items.length) {
+    container.replaceChildren(element("p", "empty", empty));
+    return;
+  }
+  container.replaceChildren(...items.map((item) => card(item, state)));
+}
+
+function card(item: WorkItemData, state: LiveState): HTMLElement {
+  const article = element("article", `card ${item.state}`);
+  article.dataset.item = String(item.id);
+  article.dataset.state = item.state;
+  const caseName = state.cases.get(item.case)?.name ?? "";
+  article.append(
+    element("h3", "", item.label || item.task),
+    element("p", "meta", `${caseName ? `${caseName} · ` : ""}case ${item.case} · ${item.state}`),
+  );
+  if (item.instructions) article.append(element("p", "instructions", item.instructions));
+  const cobots = cobotsOf(state, item);
+  if (cobots.length) {
+    const list = element("ul", "with-cobots");
+    for (const cobot of cobots) {
+      list.append(element("li", "", `${cobot.name}: ${activity(cobot)}`));
+    }
+    article.append(list);
+  }
+  const action = nextAction(state, item);
+  if (action) {
+    const button = element("button", `action ${action === "complete" ? "primary" : ""}`, label(action));
+    button.dataset.action = action;
+    button.dataset.item = String(item.id);
+    article.append(button);
+  }
+  return article;
+}
+
+function label(action: string): string {
+  return { claim: "Claim", start: "Start", complete: "Complete…" }[action] ?? action;
+}
+
+function renderCobots(state: LiveState): void {
+  const cobots = [...state.cobots.values()].sort((a, b) => a.name.localeCompare(b.name));
+  const container = $(".cobots");
+  if (!cobots.length) {
+    container.replaceChildren(element("p", "empty", "No cobots in this cell."));
+    return;
+  }
+  container.replaceChildren(...cobots.map(cobotPanel));
+}
+
+function cobotPanel(cobot: CobotData): HTMLElement {
+  const panel = element("section", "cobot");
+  panel.dataset.cobot = String(cobot.id);
+  const state = cobot.state;
+  panel.classList.toggle("stopped", cobot.stopped);
+  panel.classList.toggle("unsafe", !!state && !["SAFETY_MODE_NORMAL", "SAFETY_MODE_REDUCED"].includes(state.safety_mode));
+  panel.append(element("h3", "", cobot.name), element("p", "doing", activity(cobot)));
+  const facts = element("dl", "facts");
+  const rows: Array<[string, string]> = [
+    ["Mode", state ? state.robot_mode : "unknown"],
+    ["Safety", state ? humanSafety(state.safety_mode) : "unknown"],
+    ["Program", state ? `${state.program || "none"} · ${state.program_state}` : "unknown"],
+    ["Step", cobot.queue.current ? `${cobot.queue.current.step ?? "device call"} · case ${cobot.queue.current.case}` : "none"],
+    ["Queue", String(cobot.queue.queue_length)],
+  ];
+  for (const [term, value] of rows) {
+    facts.append(element("dt", "", term), element("dd", term.toLowerCase(), value));
+  }
+  panel.append(facts);
+  if (state) {
+    const joints = element("div", "joints");
+    degrees(state.joints).forEach((value, index) => {
+      const joint = element("div", "joint");
+      const bar = element("span", "bar");
+      bar.style.width = `${Math.min(100, (Math.abs(value) / 360) * 100)}%`;
+      joint.append(element("span", "name", `J${index + 1}`), bar, element("span", "value", `${value}°`));
+      joints.append(joint);
+    });
+    panel.append(joints);
+  }
+  return panel;
+}
+
+function renderStop(state: LiveState): void {
+  const banner = $(".stop-banner");
+  const resume = $<HTMLButtonElement>(".resume");
+  const stop = state.stop;
+  root.classList.toggle("stopped", stop !== null);
+  banner.hidden = resume.hidden = stop === null;
+  $<HTMLButtonElement>(".stop").disabled = stop !== null;
+  if (stop) {
+    const problems = Object.values(stop.problems);
+    banner.textContent =
+      `STOPPED by ${stop.stopped_by} at ${new Date(stop.stopped_at).toLocaleTimeString()}` +
+      (problems.length ? ` — ${problems.join("; ")}` : "");
+  }
+}
+
+function collectMessages(): void {
+  const state = store.state;
+  if (!state) return;
+  for (const cobot of state.cobots.values()) {
+    const text = cobot.state?.display ?? "";
+    if (text && lastDisplay.get(cobot.id) !== text) {
+      messages.unshift({ cobot: cobot.name, text, at: cobot.state!.at });
+      messages.length = Math.min(messages.length, MAX_MESSAGES);
+    }
+    lastDisplay.set(cobot.id, text);
+  }
+}
+
+function renderMessages(): void {
+  const list = $(".messages");
+  if (!messages.length) {
+    list.replaceChildren(element("li", "empty", "No messages from the cobots' displays."));
+    return;
+  }
+  list.replaceChildren(
+    ...messages.map((message) => {
+      const item = element("li", "message");
+      item.append(
+        element("time", "", new Date(message.at * 1000).toLocaleTimeString()),
+        element("strong", "", message.cobot),
+        element("span", "text", message.text),
+      );
+      return item;
+    }),
+  );
+}
+
+// Actions -----------------------------------------------------------------------------------
+
+root.addEventListener("click", (event) => {
+  const button = (event.target as HTMLElement).closest("button[data-action]") as HTMLButtonElement | null;
+  if (!button) return;
+  const id = Number(button.dataset.item);
+  const action = button.dataset.action!;
+  if (action === "complete") void openForm(id);
+  else void act(button, `/api/work-items/${id}/${action}/`);
+});
+
+async function act(button: HTMLButtonElement, url: string, body?: unknown): Promise<boolean> {
+  button.disabled = true;
+  try {
+    await request("POST", url, body ?? {});
+    return true;
+  } catch (error) {
+    flash(error instanceof ApiError ? error.message : String(error));
+    return false;
+  } finally {
+    button.disabled = false;
+  }
+}
+
+async function openForm(id: number): Promise<void> {
+  const dialog = $<HTMLDialogElement>(".form-dialog");
+  let detail: { label: string; instructions: string; form: FormSchema | null };
+  try {
+    detail = await request("GET", `/api/work-items/${id}/`);
+  } catch (error) {
+    flash(error instanceof ApiError ? error.message : String(error));
+    return;
+  }
+  const form = element("form", "task-form");
+  form.method = "dialog";
+  const fields = element("div", "fields");
+  const read = renderForm(fields, detail.form);
+  const error = element("p", "errors");
+  error.setAttribute("role", "alert");
+  const cancel = element("button", "", "Cancel");
+  cancel.type = "button";
+  cancel.addEventListener("click", () => dialog.close());
+  const submit = element("button", "primary", "Complete");
+  submit.type = "submit";
+  const actions = element("div", "actions");
+  actions.append(cancel, submit);
+  form.append(element("h2", "", detail.label), element("p", "instructions", detail.instructions), fields, error, actions);
+  form.addEventListener("submit", async (event) => {
+    event.preventDefault();
+    submit.disabled = true;
+    try {
+      await request("POST", `/api/work-items/${id}/complete/`, { data: read() });
+      dialog.close();
+    } catch (failure) {
+      error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+    } finally {
+      submit.disabled = false;
+    }
+  });
+  dialog.replaceChildren(form);
+  dialog.showModal();
+}
+
+$(".stop").addEventListener("click", () => {
+  void act($(".stop"), "/api/cells/stop/", { organisation: config.organisation, cell: config.cell });
+});
+
+$(".resume").addEventListener("click", () => $<HTMLDialogElement>(".confirm-dialog").showModal());
+$<HTMLDialogElement>(".confirm-dialog").addEventListener("close", () => {
+  const dialog = $<HTMLDialogElement>(".confirm-dialog");
+  if (dialog.returnValue === "resume") {
+    void act($(".resume"), "/api/cells/resume/", {
+      organisation: config.organisation,
+      cell: config.cell,
+      confirm: true,
+    });
+  }
+  dialog.returnValue = "";
+});
+
+function flash(text: string): void {
+  const connection = $(".connection");
+  const note = element("span", "flash", text);
+  note.setAttribute("role", "alert");
+  connection.after(note);
+  setTimeout(() => note.remove(), 6000);
+}
+
+function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = "", text?: string): HTMLElementTagNameMap[K] {
+  const node = document.createElement(tag);
+  if (className) node.className = className;
+  if (text !== undefined) node.textContent = text;
+  return node;
+}
+
+// For the browser tests and a curious engineer's console.
+(window as unknown as { hrcTablet: unknown }).hrcTablet = { store, socket };
+socket.start();
