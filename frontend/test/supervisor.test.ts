@@ -1,7 +1,13 @@
 import { describe, expect, it } from "vitest";
 
 import { Refusal, refusalMessage, type EventJson, type IncidentJson, type WorkItemJson } from "../src/supervisor/api";
+import type { LiveEvent } from "../src/live/events";
 import {
+  POLL_MS,
+  SAFETY_POLL_MS,
+  concernsCase,
+  concernsIncidents,
+  pollInterval,
   constraintTokens,
   formatTime,
   markingChange,
@@ -211,5 +217,33 @@ describe("JSON on the page", () => {
     expect(prettyJson({ b: 1, a: { d: [2], c: true } })).toBe(
       '{\n  "a": {\n    "c": true,\n    "d": [\n      2\n    ]\n  },\n  "b": 1\n}',
     );
+  });
+});
+
+describe("the live socket as a doorbell", () => {
+  const delta = (type: "case" | "work-item" | "incident", caseId: number) => ({ type, case: caseId, seq: 4 }) as unknown as LiveEvent;
+  const snapshot = { type: "snapshot" } as unknown as LiveEvent;
+  const cobotState = { type: "cobot-state", states: [] } as unknown as LiveEvent;
+
+  it("rings a case page for its own case's deltas and every snapshot", () => {
+    expect(concernsCase(delta("work-item", 3), 3)).toBe(true);
+    expect(concernsCase(delta("incident", 3), 3)).toBe(true);
+    expect(concernsCase(delta("case", 3), 3)).toBe(true);
+    expect(concernsCase(delta("case", 4), 3)).toBe(false);
+    expect(concernsCase(cobotState, 3)).toBe(false);
+    expect(concernsCase(snapshot, 3)).toBe(true);
+  });
+
+  it("rings the incidents page for incidents of any case", () => {
+    expect(concernsIncidents(delta("incident", 9))).toBe(true);
+    expect(concernsIncidents(delta("work-item", 9))).toBe(false);
+    expect(concernsIncidents(snapshot)).toBe(true);
+  });
+
+  it("polls fast unless every socket is live", () => {
+    expect(pollInterval([])).toBe(POLL_MS);
+    expect(pollInterval(["live", "reconnecting"])).toBe(POLL_MS);
+    expect(pollInterval(["live", "live"])).toBe(SAFETY_POLL_MS);
+    expect(SAFETY_POLL_MS).toBeGreaterThan(POLL_MS);
   });
 });

@@ -53,6 +53,8 @@ STATE_FILTERS: dict[str, frozenset[str] | None] = {
     "all": None,
 }
 EVENT_NAMES = dict(EventType.choices)
+# The live socket (hrc/live/routing.py): the pages' doorbell for changes.
+LIVE_SOCKET = "/ws/live/"
 
 
 class Refused(Exception):
@@ -177,6 +179,8 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "section": "cases",
         "script": {
             "page": "case",
+            "organisations": [case.organisation_id],
+            "socket": LIVE_SOCKET,
             "case": case.pk,
             "lastSeq": case.last_seq,
             # Only the newest page grows with new events; an older page stays as it is.
@@ -350,6 +354,8 @@ def incident_list(request: HttpRequest) -> HttpResponse:
     page = Paginator(incidents, INCIDENTS_PER_PAGE).get_page(request.GET.get("page"))
     script = {
         "page": "incidents",
+        "organisations": list(writable_organisations(request.user).values_list("pk", flat=True)),
+        "socket": LIVE_SOCKET,
         "api": {
             "incidents": reverse("incident-list"),
             "resolve": reverse("incident-resolve", args=[0]),

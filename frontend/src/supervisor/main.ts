@@ -1,10 +1,15 @@
 // The supervisor pages' script (templates/cases/): keeps the case page's marking, open
 // tasks, incidents and timeline up to date, and resolves incidents through the REST API.
 //
-// Updates come by polling the API every POLL_MS; a case page asks for the events and
-// incidents only when the case's last event number has moved, so an idle case costs one
-// small request per poll.
+// The live socket (/ws/live/, hrc/live/) is the doorbell: a delta about the page's case
+// (or any incident, on the incidents page) makes the page read the REST API again; the
+// deltas themselves carry no marking. While the socket is not live the page polls every
+// POLL_MS instead, and even while it is, every SAFETY_POLL_MS. A case page asks for events
+// and incidents only when the case's last event number has moved.
 
+import type { LiveEvent } from "../live/events";
+import { type ConnectionStatus, LiveSocket } from "../live/socket";
+import { LiveStore } from "../live/store";
 import {
   Refusal,
   getJson,
@@ -15,7 +20,10 @@ import {
   type PageJson,
 } from "./api";
 import {
+  concernsCase,
+  concernsIncidents,
   openIncidents,
+  pollInterval,
   prettyJson,
   resolveBody,
   taskStates,
@@ -34,11 +42,12 @@ import {
   renderWorkRows,
 } from "./render";
 
-export const POLL_MS = 2000;
 const EVENTS_PER_REQUEST = 200;
 
 interface CasePageConfig {
   page: "case";
+  organisations: number[];
+  socket: string;
   case: number;
   lastSeq: number;
   live: boolean;
@@ -48,6 +57,8 @@ interface CasePageConfig {
 
 interface IncidentsPageConfig {
   page: "incidents";
+  organisations: number[];
+  socket: string;
   live: boolean;
   api: { incidents: string; resolve: string; case: string };
 }
@@ -58,32 +69,83 @@ function csrfToken(): string {
   return document.querySelector<HTMLMetaElement>('meta[name="csrf-token"]')?.content ?? "";
 }
 
-function liveStatus(text: string): void {
-  const status = document.getElementById("live-status");
-  if (status) status.textContent = text;
-}
+const STATUS_TEXT: Record<ConnectionStatus, string> = {
+  connecting: "connecting…",
+  live: "live",
+  reconnecting: "reconnecting",
+  refused: "refused",
+};
 
-/** Runs `refresh` every POLL_MS, never two at once; a failure is shown and retried. */
-function poll(refresh: () => Promise<void>): { now: () => Promise<void> } {
-  let running: Promise<void> | null = null;
-  const once = async (): Promise<void> => {
-    if (running) return running;
-    running = refresh()
-      .then(() => liveStatus(""))
-      .catch((error: unknown) => {
-        const message = error instanceof Refusal ? error.message : String(error);
-        liveStatus(`Live updates paused: ${message}`);
-      })
+/**
+ * Reads the page's state again when asked (a delta rang, an incident was resolved) and on a
+ * timer: POLL_MS while no live socket is up, SAFETY_POLL_MS while one is. Never two reads at
+ * once; a request during a read gets one more read after it, so no change is missed.
+ */
+class Refresher {
+  private running: Promise<void> | null = null;
+  private again = false;
+  private timer = 0;
+  private sockets = new Map<number, ConnectionStatus>();
+
+  constructor(private readonly refresh: () => Promise<void>) {
+    this.schedule();
+  }
+
+  request(): Promise<void> {
+    if (this.running) {
+      this.again = true;
+      return this.running;
+    }
+    this.running = this.refresh()
+      .then(() => this.show(""))
+      .catch((error: unknown) => this.show(error instanceof Refusal ? error.message : String(error)))
       .finally(() => {
-        running = null;
+        this.running = null;
+        if (this.again) {
+          this.again = false;
+          void this.request();
+        }
       });
-    return running;
-  };
-  const loop = (): void => {
-    void once().then(() => window.setTimeout(loop, POLL_MS));
-  };
-  window.setTimeout(loop, POLL_MS);
-  return { now: once };
+    return this.running;
+  }
+
+  /** Follows the organisations' live sockets: a delta that concerns the page rings. */
+  listen(config: { organisations: number[]; socket: string }, concerns: (event: LiveEvent) => boolean): void {
+    const scheme = window.location.protocol === "https:" ? "wss:" : "ws:";
+    for (const organisation of config.organisations) {
+      const store = new LiveStore();
+      store.subscribe((event) => {
+        if (concerns(event)) void this.request();
+      });
+      this.sockets.set(organisation, "connecting");
+      new LiveSocket({
+        url: `${scheme}//${window.location.host}${config.socket}?organisation=${organisation}`,
+        store,
+        onStatus: (status) => {
+          this.sockets.set(organisation, status);
+          this.show("");
+          this.schedule();
+        },
+      }).start();
+    }
+  }
+
+  private schedule(): void {
+    window.clearTimeout(this.timer);
+    this.timer = window.setTimeout(() => {
+      void this.request().then(() => this.schedule());
+    }, pollInterval([...this.sockets.values()]));
+  }
+
+  private show(problem: string): void {
+    const status = document.getElementById("live-status");
+    if (!status) return;
+    const states = [...this.sockets.values()];
+    const live = states.length > 0 && states.every((state) => state === "live");
+    status.dataset.live = live ? "socket" : "polling";
+    const how = live ? "Live" : `Polling every ${pollInterval(states) / 1000} s (live socket: ${states.map((s) => STATUS_TEXT[s]).join(", ") || "none"})`;
+    status.textContent = problem ? `Updates paused: ${problem}` : how;
+  }
 }
 
 // Resolving incidents -----------------------------------------------------------------------
@@ -181,8 +243,9 @@ function startCasePage(config: CasePageConfig): void {
     lastSeq = Math.max(lastSeq, ...events.map((event) => event.seq));
   };
 
-  const poller = poll(refresh);
-  onResolve(config.api.resolve, poller.now);
+  const refresher = new Refresher(refresh);
+  refresher.listen(config, (event) => concernsCase(event, config.case));
+  onResolve(config.api.resolve, () => refresher.request());
 }
 
 // The incidents page ------------------------------------------------------------------------
@@ -205,8 +268,9 @@ function startIncidentsPage(config: IncidentsPageConfig): void {
     document.querySelector<HTMLElement>("p.empty")?.toggleAttribute("hidden", list.children.length > 0);
   };
 
-  const poller = poll(refresh);
-  onResolve(config.api.resolve, poller.now);
+  const refresher = new Refresher(refresh);
+  refresher.listen(config, concernsIncidents);
+  onResolve(config.api.resolve, () => refresher.request());
 }
 
 function start(): void {

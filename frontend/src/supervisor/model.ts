@@ -2,7 +2,30 @@
 // log mean on the page. The server renders the first view with the same rules
 // (hrc/cases/views.py); these keep it up to date.
 
+import type { LiveEvent } from "../live/events";
+import type { ConnectionStatus } from "../live/socket";
 import type { CaseJson, EventJson, IncidentJson, JobJson, Marking, WorkItemJson } from "./api";
+
+/** How often the page reads the API without a live socket, and with one (to catch a missed ring). */
+export const POLL_MS = 2000;
+export const SAFETY_POLL_MS = 30_000;
+
+/** The polling interval for these live sockets' states: slow only while every one is live. */
+export function pollInterval(sockets: readonly ConnectionStatus[]): number {
+  return sockets.length > 0 && sockets.every((status) => status === "live") ? SAFETY_POLL_MS : POLL_MS;
+}
+
+/** Whether a live event may change a case page: a (re)connection's snapshot, or a delta of the case. */
+export function concernsCase(event: LiveEvent, caseId: number): boolean {
+  if (event.type === "snapshot") return true;
+  if (event.type === "case" || event.type === "work-item" || event.type === "incident") return event.case === caseId;
+  return false;
+}
+
+/** Whether a live event may change the incidents page: a snapshot or any incident delta. */
+export function concernsIncidents(event: LiveEvent): boolean {
+  return event.type === "snapshot" || event.type === "incident";
+}
 
 export type TaskState = "incident" | "running" | "offered" | "";
 
