@@ -9,6 +9,7 @@ import {
   prependTimeline,
   renderIncident,
   renderWorkRows,
+  trimTimeline,
 } from "../src/supervisor/render";
 
 // The shape templates/cases/_net.html draws.
@@ -134,5 +135,14 @@ describe("tables", () => {
     expect([...body.querySelectorAll("tr")].map((tr) => tr.dataset.seq)).toEqual(["4", "3", "2", "1"]);
     expect(body.querySelector("tr")!.textContent).toContain("Task completed");
     expect(body.querySelector("tr")!.textContent).toContain("count parts");
+  });
+
+  it("keeps only the newest rows of a timeline that has grown", () => {
+    document.body.innerHTML = "<table><tbody></tbody></table>";
+    const body = document.querySelector("tbody")!;
+    body.innerHTML = [6, 5, 4, 3, 2].map((seq) => `<tr data-seq="${seq}"></tr>`).join("");
+    expect(trimTimeline(body, 5)).toBeNull();
+    expect(trimTimeline(body, 3)).toBe(4);
+    expect([...body.querySelectorAll("tr")].map((tr) => tr.dataset.seq)).toEqual(["6", "5", "4"]);
   });
 });

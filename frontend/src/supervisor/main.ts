@@ -40,9 +40,12 @@ import {
   applyStatus,
   prependTimeline,
   renderWorkRows,
+  trimTimeline,
 } from "./render";
 
 const EVENTS_PER_REQUEST = 200;
+// An open page of a long case keeps this many of its newest events; older ones are a link away.
+const MAX_TIMELINE_ROWS = 200;
 
 interface CasePageConfig {
   page: "case";
@@ -143,7 +146,8 @@ class Refresher {
     const states = [...this.sockets.values()];
     const live = states.length > 0 && states.every((state) => state === "live");
     status.dataset.live = live ? "socket" : "polling";
-    const how = live ? "Live" : `Polling every ${pollInterval(states) / 1000} s (live socket: ${states.map((s) => STATUS_TEXT[s]).join(", ") || "none"})`;
+    const sockets = states.map((state) => STATUS_TEXT[state]).join(", ") || "none";
+    const how = live ? "Live" : `Polling every ${pollInterval(states) / 1000} s (live socket: ${sockets})`;
     status.textContent = problem ? `Updates paused: ${problem}` : how;
   }
 }
@@ -204,6 +208,20 @@ async function allEventsAfter(url: string, after: number): Promise<EventJson[]> 
   return events;
 }
 
+/** Points the timeline's "Older events" link at the events before `seq`. */
+function showOlder(seq: number): void {
+  const pager = document.querySelector('nav[aria-label="Timeline pages"]');
+  if (!pager) return;
+  let link = pager.querySelector<HTMLAnchorElement>('a[rel="next"]');
+  if (!link) {
+    link = document.createElement("a");
+    link.rel = "next";
+    link.textContent = "Older events";
+    pager.append(link);
+  }
+  link.href = `?before=${seq}`;
+}
+
 /** Swaps the interruptions table for the server's current one (no API lists interruptions). */
 async function refreshInterruptions(): Promise<void> {
   const response = await fetch(window.location.href, { credentials: "same-origin" });
@@ -223,7 +241,10 @@ function startCasePage(config: CasePageConfig): void {
     const current = await getJson<CaseJson>(config.api.case);
     const badge = document.getElementById("case-status");
     if (badge) applyStatus(badge, current.status);
-    if (net) applyMarking(net, current.marking, taskStates(tasks, current.marking, current.work_items, openIncidents(current)));
+    if (net) {
+      const states = taskStates(tasks, current.marking, current.work_items, openIncidents(current));
+      applyMarking(net, current.marking, states);
+    }
     const workBody = document.querySelector<HTMLTableSectionElement>("#work-items tbody");
     if (workBody) renderWorkRows(workBody, current.work_items.map(workRow));
     const data = document.getElementById("case-data");
@@ -232,7 +253,11 @@ function startCasePage(config: CasePageConfig): void {
     const events = unseenEvents(lastSeq, await allEventsAfter(config.api.events, lastSeq));
     if (config.live) {
       const timeline = document.querySelector<HTMLTableSectionElement>("#timeline tbody");
-      if (timeline) prependTimeline(timeline, events.map((event) => timelineRow(event, config.labels)));
+      if (timeline) {
+        prependTimeline(timeline, events.map((event) => timelineRow(event, config.labels)));
+        const oldest = trimTimeline(timeline, MAX_TIMELINE_ROWS);
+        if (oldest !== null) showOlder(oldest);
+      }
     }
     if (incidents) {
       const page = await getJson<PageJson<IncidentJson>>(config.api.incidents);

@@ -87,7 +87,12 @@ export function renderIncident(incident: IncidentJson, options: IncidentOptions 
   );
   if (incident.cobot_state) {
     card.append(
-      element("details", {}, element("summary", {}, "Cobot state"), element("pre", { class: "json" }, prettyJson(incident.cobot_state))),
+      element(
+        "details",
+        {},
+        element("summary", {}, "Cobot state"),
+        element("pre", { class: "json" }, prettyJson(incident.cobot_state)),
+      ),
     );
   }
   const outputs = element("textarea", { name: "outputs", spellcheck: "false" });
@@ -117,7 +122,11 @@ export function applyIncident(card: HTMLElement, incident: IncidentJson): void {
 }
 
 /** Adds cards for incidents not on the page yet (newest on top) and updates the others. */
-export function applyIncidents(list: HTMLElement, incidents: readonly IncidentJson[], options: IncidentOptions = {}): void {
+export function applyIncidents(
+  list: HTMLElement,
+  incidents: readonly IncidentJson[],
+  options: IncidentOptions = {},
+): void {
   const newestFirst = [...incidents].sort((a, b) => b.id - a.id);
   for (const incident of [...newestFirst].reverse()) {
     const card = list.querySelector<HTMLElement>(`[data-incident="${incident.id}"]`);
@@ -137,7 +146,10 @@ export function renderWorkRows(body: HTMLTableSectionElement, rows: readonly Wor
       element("td", {}, row.job),
     ),
   );
-  if (!lines.length) lines.push(element("tr", { class: "none" }, element("td", { colspan: "4", class: "muted" }, "No open tasks.")));
+  if (!lines.length) {
+    const none = element("td", { colspan: "4", class: "muted" }, "No open tasks.");
+    lines.push(element("tr", { class: "none" }, none));
+  }
   body.replaceChildren(...lines);
 }
 
@@ -162,4 +174,15 @@ export function prependTimeline(body: HTMLTableSectionElement, rows: readonly Ti
     if (body.querySelector(`tr[data-seq="${row.seq}"]`)) continue;
     body.prepend(renderTimelineRow(row));
   }
+}
+
+/**
+ * Keeps the newest `max` rows of a timeline that has grown on an open page; returns the seq
+ * of the oldest row kept (where the "older events" link starts), or null when none was cut.
+ */
+export function trimTimeline(body: HTMLTableSectionElement, max: number): number | null {
+  const rows = [...body.querySelectorAll<HTMLTableRowElement>("tr[data-seq]")];
+  if (rows.length <= max) return null;
+  rows.slice(max).forEach((row) => row.remove());
+  return Number(rows[max - 1].dataset.seq);
 }
