@@ -4,7 +4,9 @@
 - `rules`, `classify`: the formal rules and the four patterns;
 - `execution`, `petri`: the execution net and its firing rule (used by the runtime);
 - `reduction`, `analysis`: soundness by reduced state-space exploration, with witnesses;
-- `check`: all of it in one report; `pnml`: PNML import and export.
+- `check`: all of it in one report; `pnml`: PNML import and export;
+- `layout`: automatic layout in actor lanes; `bpmn`, `bpmn_net`, `bpmn_export`: BPMN 2.0
+  import (Dijkman, Dumas and Ouyang's mapping) and export with a diagram.
 """
 
 from hrc.engine.check import CheckReport, check_document, check_pattern

@@ -1,0 +1,610 @@
+"""BPMN 2.0 export of collaboration patterns, with a diagram (BPMNDI) from the layout.
+
+`pattern_to_bpmn` writes one pool per process and one lane per actor, so BPMN
+tools (bpmn.io, Camunda Modeler, Signavio, ...) show the pattern as its
+engineer drew it. The net becomes BPMN the reverse way of `bpmn.py`'s import:
+
+| hrc-pattern/1 | BPMN |
+| --- | --- |
+| task (a transition with a performer) | a task in its performer's lane (a `userTask`, ... when the transition's `bpmn` key says so); a task with several input places gets a parallel gateway `<task>_join` before it |
+| silent transition | a parallel gateway (it consumes all its inputs and produces all its outputs) |
+| source place | a start event (followed by an exclusive gateway `<place>_split` when several transitions compete for its token) |
+| sink place | an end event, reached by a flow from each transition that marks it |
+| any other place with one input and one output transition | a sequence flow |
+| a place with several inputs or outputs | an exclusive gateway (a merge, a choice, or both) between sequence flows |
+| constraint | an association between the two tasks with `hrc:constraint="time"` (or space, func) |
+
+What BPMN cannot say travels in `<hrc:extra>` (see `bpmn.py`): task
+configuration, guards, initial tokens, workpieces, the declared pattern, and
+any id XML cannot hold as written; `bpmn.bpmn_to_pattern` reads it back.
+Positions come from the document's `layout` (`layout.lay_out` when it has
+none): tasks, gateways and events at their nodes' centres, pools and lanes as
+the layout's lane bands.
+
+A net BPMN cannot draw is refused with a FormatError naming the elements:
+duplicate ids, and arcs to unknown nodes or between two places or two
+transitions. Initial tokens travel in `<hrc:extra>` like the rest; other tools
+start a case with one token at each start event, whatever the places say.
+"""
+
+import json
+import math
+import re
+import xml.etree.ElementTree as ET
+from collections import defaultdict
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from hrc.engine.bpmn import (
+    BPMN_NAMESPACE,
+    BPMNDI_NAMESPACE,
+    DC_NAMESPACE,
+    DI_NAMESPACE,
+    HRC_NAMESPACE,
+)
+from hrc.engine.bpmn_net import TASK_KINDS
+from hrc.engine.document import FormatError
+from hrc.engine.issues import error
+from hrc.engine.layout import TASK_HEIGHT, TASK_WIDTH, lay_out_pattern
+from hrc.engine.model import Actor, Pattern, Place, Process, Transition
+from hrc.engine.rules import check_rules
+
+Json = dict[str, Any]
+
+for _prefix, _uri in (
+    ("bpmn", BPMN_NAMESPACE),
+    ("bpmndi", BPMNDI_NAMESPACE),
+    ("dc", DC_NAMESPACE),
+    ("di", DI_NAMESPACE),
+    ("hrc", HRC_NAMESPACE),
+):
+    ET.register_namespace(_prefix, _uri)
+
+TARGET_NAMESPACE = "urn:hrc:pattern"
+EVENT_SIZE = 36.0
+GATEWAY_SIZE = 50.0
+JOIN_SIZE = 36.0
+"""A join squeezed in before a task, in the gap between two columns."""
+POOL_HEADER_WIDTH = 30.0
+"""Less than layout.LANE_HEADER_WIDTH, so the nodes stay clear of the pool's header."""
+UNREPRESENTABLE = ("duplicate-id", "unknown-node", "arc-kind")
+
+
+def pattern_to_bpmn(pattern: Pattern) -> str:
+    """The BPMN 2.0 XML of a pattern; raises FormatError when BPMN cannot represent it."""
+    _check_representable(pattern)
+    if not _has_layout(pattern):
+        pattern = lay_out_pattern(pattern)
+    return _Writer(pattern).text()
+
+
+def _check_representable(pattern: Pattern) -> None:
+    issues = [
+        error("format", f"The model cannot be written as BPMN: {issue.message}", *issue.elements)
+        for issue in check_rules(pattern)
+        if issue.code in UNREPRESENTABLE
+    ]
+    if issues:
+        raise FormatError(issues)
+
+
+def _point(extra: Mapping[str, Any]) -> tuple[float, float] | None:
+    """A node's centre from its `layout`; None when it has none that is usable."""
+    layout = extra.get("layout")
+    if not isinstance(layout, dict):
+        return None
+    x, y = _number(layout.get("x")), _number(layout.get("y"))
+    return None if x is None or y is None else (x, y)
+
+
+def _number(value: object) -> float | None:
+    if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+        return float(value)
+    return None
+
+
+def _is_number(value: object) -> bool:
+    return _number(value) is not None
+
+
+def _has_layout(pattern: Pattern) -> bool:
+    """Whether every node has a position and the document its lanes, as `lay_out` writes them."""
+    layout = pattern.extra.get("layout")
+    if not isinstance(layout, dict) or not _is_number(layout.get("width")):
+        return False
+    lanes = layout.get("lanes")
+    if not isinstance(lanes, list) or not all(
+        isinstance(lane, dict) and _is_number(lane.get("y")) and _is_number(lane.get("height"))
+        for lane in lanes
+    ):
+        return False
+    drawn = {lane.get("actor") for lane in lanes}
+    if any(actor.id not in drawn for actor in pattern.actors):
+        return False
+    return all(
+        _point(node.extra) is not None for process in pattern.processes for node in _nodes(process)
+    )
+
+
+def _nodes(process: Process) -> list[Place | Transition]:
+    return [*process.places, *process.transitions]
+
+
+# Ids and text ------------------------------------------------------------------------------
+
+_NCNAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*")
+_NOT_XML_TEXT = re.compile("[^\t\n\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def _is_text(value: str) -> bool:
+    """Whether XML gives this string back exactly (it cannot hold some characters, nor a CR)."""
+    return _NOT_XML_TEXT.search(value) is None
+
+
+class _Ids:
+    """XML ids: an element keeps its hrc id where that is an NCName not taken yet."""
+
+    def __init__(self, pattern: Pattern) -> None:
+        ids = [actor.id for actor in pattern.actors]
+        for process in pattern.processes:
+            ids += [process.id, *(node.id for node in _nodes(process))]
+        self.reserved = {element_id for element_id in ids if _NCNAME.fullmatch(element_id)}
+        self.taken: set[str] = set()
+
+    def own(self, hrc_id: str, fallback: str) -> tuple[str, bool]:
+        """(XML id, whether it is the hrc id) for an element that stands for `hrc_id`."""
+        if _NCNAME.fullmatch(hrc_id) and hrc_id not in self.taken:
+            self.taken.add(hrc_id)
+            return hrc_id, True
+        return self.fresh(fallback), False
+
+    def fresh(self, base: str) -> str:
+        base = re.sub(r"[^A-Za-z0-9_.\-]", "_", base)
+        base = base if _NCNAME.fullmatch(base) else f"id_{base}"
+        candidate, number = base, 1
+        while candidate in self.taken or candidate in self.reserved:
+            number += 1
+            candidate = f"{base}_{number}"
+        self.taken.add(candidate)
+        return candidate
+
+
+# Writing -----------------------------------------------------------------------------------
+
+
+def _tag(local: str, namespace: str = BPMN_NAMESPACE) -> str:
+    return f"{{{namespace}}}{local}"
+
+
+@dataclass
+class _Shape:
+    element: str
+    centre: tuple[float, float]
+    size: tuple[float, float]
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        (x, y), (w, h) = self.centre, self.size
+        return x - w / 2, y - h / 2, w, h
+
+
+class _Writer:
+    def __init__(self, pattern: Pattern) -> None:
+        self.pattern = pattern
+        self.ids = _Ids(pattern)
+        self.shapes: list[_Shape] = []
+        self.edges: list[tuple[str, str, str]] = []
+        """(flow or association id, source element, target element)."""
+        self.element_of: dict[str, str] = {}
+        """hrc task id -> the XML id of its task (constraint ends)."""
+        self.process_of_task: dict[str, ET.Element] = {}
+        self.pool_lanes: list[tuple[str, tuple[float, float, float, float]]] = []
+        layout = pattern.extra["layout"]
+        self.width = float(layout["width"])
+        self.bands: dict[str | None, tuple[float, float]] = {}
+        for lane in layout["lanes"]:
+            actor = lane.get("actor")
+            self.bands.setdefault(
+                actor if isinstance(actor, str) else None, (float(lane["y"]), float(lane["height"]))
+            )
+
+    def text(self) -> str:
+        pattern = self.pattern
+        root = ET.Element(
+            _tag("definitions"),
+            {
+                "id": self.ids.fresh("definitions"),
+                "targetNamespace": TARGET_NAMESPACE,
+                "exporter": "hrc",
+                "exporterVersion": "1",
+            },
+        )
+        document_extra: Json = {k: v for k, v in pattern.extra.items() if k != "layout"}
+        if _is_text(pattern.name):
+            root.set("name", pattern.name)
+        else:
+            document_extra["name"] = pattern.name
+        if pattern.declared_pattern is not None:
+            root.set(_tag("declaredPattern", HRC_NAMESPACE), pattern.declared_pattern)
+        collaboration = ET.SubElement(
+            root, _tag("collaboration"), id=self.ids.fresh("collaboration")
+        )
+        # The actors' order (the editor's lanes); import sorts the lanes' actors by it.
+        document_extra["actors"] = [actor.id for actor in pattern.actors]
+        _add_extra(collaboration, document_extra)
+        processes = []
+        pools: list[tuple[str, Process]] = []
+        for process in pattern.processes:
+            element, pool = self._process(process, collaboration)
+            processes.append(element)
+            pools.append((pool, process))
+        for element in processes:
+            root.append(element)
+        self._constraints(collaboration)
+        self._diagram(root, collaboration.get("id", ""), pools)
+        ET.indent(root)
+        return (
+            '<?xml version="1.0" encoding="UTF-8"?>\n'
+            + ET.tostring(root, encoding="unicode")
+            + "\n"
+        )
+
+    # Processes.
+
+    def _process(self, process: Process, collaboration: ET.Element) -> tuple[ET.Element, str]:
+        xml_id, faithful = self.ids.own(process.id, "process")
+        element = ET.Element(_tag("process"), id=xml_id, isExecutable="false")
+        extra: Json = {k: v for k, v in process.extra.items() if k != "layout"}
+        if not faithful:
+            extra["id"] = process.id
+        name = extra.get("name")
+        if isinstance(name, str) and _is_text(name):
+            element.set("name", name)
+            del extra["name"]
+        if process.workpiece is not None:
+            if _is_text(process.workpiece):
+                element.set(_tag("workpiece", HRC_NAMESPACE), process.workpiece)
+            else:
+                extra["workpiece"] = process.workpiece
+        _add_extra(element, extra)
+        pool = self.ids.fresh(f"{xml_id}_pool")
+        participant = ET.SubElement(collaboration, _tag("participant"), id=pool, processRef=xml_id)
+        participant.set("name", element.get("name") or xml_id)
+        _ProcessWriter(self, process, element).write()
+        return element, pool
+
+    def _constraints(self, collaboration: ET.Element) -> None:
+        for constraint in self.pattern.constraints:
+            source = self.element_of.get(constraint.source)
+            target = self.element_of.get(constraint.target)
+            if source is None or target is None:
+                continue  # a constraint on a silent step: the rules report it, BPMN has no place for it
+            home = self.process_of_task.get(constraint.source, collaboration)
+            association_id = self.ids.fresh(f"{constraint.type}_{source}_{target}")
+            association = ET.Element(
+                _tag("association"),
+                id=association_id,
+                sourceRef=source,
+                targetRef=target,
+                associationDirection="One",
+            )
+            extra: Json = dict(constraint.extra)
+            if _is_text(constraint.type):
+                association.set(_tag("constraint", HRC_NAMESPACE), constraint.type)
+            else:
+                association.set(_tag("constraint", HRC_NAMESPACE), "")
+                extra["type"] = constraint.type
+            _add_extra(association, extra)
+            home.append(association)
+            self.edges.append((association_id, source, target))
+
+    # The diagram.
+
+    def _diagram(self, root: ET.Element, plane_of: str, pools: list[tuple[str, Process]]) -> None:
+        diagram = ET.SubElement(
+            root, _tag("BPMNDiagram", BPMNDI_NAMESPACE), id=self.ids.fresh("diagram")
+        )
+        plane = ET.SubElement(
+            diagram,
+            _tag("BPMNPlane", BPMNDI_NAMESPACE),
+            id=self.ids.fresh("plane"),
+            bpmnElement=plane_of,
+        )
+        for pool, process in pools:
+            top, bottom = self._pool_band(process)
+            self._shape(plane, pool, (0.0, top, self.width, bottom - top), horizontal=True)
+        for lane, bounds in self.pool_lanes:
+            self._shape(plane, lane, bounds, horizontal=True)
+        by_element = {shape.element: shape for shape in self.shapes}
+        for shape in self.shapes:
+            self._shape(plane, shape.element, shape.bounds)
+        for edge_id, source, target in self.edges:
+            edge = ET.SubElement(
+                plane,
+                _tag("BPMNEdge", BPMNDI_NAMESPACE),
+                id=self.ids.fresh(f"{edge_id}_di"),
+                bpmnElement=edge_id,
+            )
+            for x, y in _waypoints(by_element[source], by_element[target]):
+                ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
+
+    def _pool_band(self, process: Process) -> tuple[float, float]:
+        bands = [self.bands[actor] for actor in _lane_actors(process) if actor in self.bands]
+        if not bands:
+            ys = [
+                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
+            ] or [0.0]
+            return min(ys) - TASK_HEIGHT, max(ys) + TASK_HEIGHT
+        return min(top for top, _ in bands), max(top + height for top, height in bands)
+
+    def _shape(
+        self,
+        plane: ET.Element,
+        element: str,
+        bounds: tuple[float, float, float, float],
+        *,
+        horizontal: bool = False,
+    ) -> None:
+        shape = ET.SubElement(
+            plane,
+            _tag("BPMNShape", BPMNDI_NAMESPACE),
+            id=self.ids.fresh(f"{element}_di"),
+            bpmnElement=element,
+        )
+        if horizontal:
+            shape.set("isHorizontal", "true")
+        x, y, width, height = bounds
+        ET.SubElement(
+            shape,
+            _tag("Bounds", DC_NAMESPACE),
+            x=_num(x),
+            y=_num(y),
+            width=_num(width),
+            height=_num(height),
+        )
+
+
+def _lane_actors(process: Process) -> list[str]:
+    """The process' actors, then any performer that is not one of them."""
+    performers = [t.performer for t in process.transitions if t.performer is not None]
+    return list(dict.fromkeys([*process.actors, *performers]))
+
+
+class _ProcessWriter:
+    """One process' lanes, flow nodes and sequence flows."""
+
+    def __init__(self, writer: _Writer, process: Process, element: ET.Element) -> None:
+        self.writer = writer
+        self.ids = writer.ids
+        self.process = process
+        self.element = element
+        self.inputs: dict[str, list[str]] = defaultdict(list)
+        self.outputs: dict[str, list[str]] = defaultdict(list)
+        self.producers: dict[str, list[str]] = defaultdict(list)
+        self.consumers: dict[str, list[str]] = defaultdict(list)
+        transitions = {t.id for t in process.transitions}
+        for source, target in process.arcs:
+            if target in transitions:
+                self.inputs[target].append(source)
+                self.consumers[source].append(target)
+            else:
+                self.outputs[source].append(target)
+                self.producers[target].append(source)
+        self.node_of: dict[str, str] = {}
+        """hrc transition id -> the XML id of its element."""
+        self.entry_of: dict[str, str] = {}
+        """hrc transition id -> the element its incoming flows go to (the task, or its join)."""
+        self.nodes: list[ET.Element] = []
+        self.flows: list[ET.Element] = []
+
+    def write(self) -> None:
+        lane_set = ET.SubElement(
+            self.element, _tag("laneSet"), id=self.ids.fresh(f"{self.element.get('id')}_lanes")
+        )
+        lanes = {actor: self._lane(lane_set, actor) for actor in _lane_actors(self.process)}
+        if not lanes:
+            self.element.remove(lane_set)
+        for transition in self.process.transitions:
+            self._transition(transition, lanes)
+        for place in self.process.places:
+            self._place(place)
+        incoming: dict[str, list[str]] = defaultdict(list)
+        outgoing: dict[str, list[str]] = defaultdict(list)
+        for flow in self.flows:
+            outgoing[flow.get("sourceRef", "")].append(flow.get("id", ""))
+            incoming[flow.get("targetRef", "")].append(flow.get("id", ""))
+        for node in self.nodes:
+            # Optional in BPMN, but some tools read a node's flows only from these.
+            node_id = node.get("id", "")
+            for local, flows in (("incoming", incoming[node_id]), ("outgoing", outgoing[node_id])):
+                for flow_id in flows:
+                    ET.SubElement(node, _tag(local)).text = flow_id
+            self.element.append(node)
+        for flow in self.flows:
+            self.element.append(flow)
+
+    def _lane(self, lane_set: ET.Element, actor_id: str) -> ET.Element:
+        xml_id, faithful = self.ids.own(actor_id, f"lane_{actor_id}")
+        lane = ET.SubElement(lane_set, _tag("lane"), id=xml_id)
+        actor: Actor | None = self.writer.pattern.actor(actor_id)
+        extra: Json = dict(actor.extra) if actor else {}
+        if not faithful:
+            extra["id"] = actor_id
+        name = extra.pop("name", None)
+        if not (isinstance(name, str) and name and _is_text(name)):
+            if name is not None:
+                extra["name"] = name
+            name = actor_id if _is_text(actor_id) else xml_id
+        lane.set("name", name)
+        if actor is not None:
+            lane.set(_tag("actorType", HRC_NAMESPACE), actor.type)
+        _add_extra(lane, extra)
+        band = self.writer.bands.get(actor_id if actor is not None else None)
+        if band is not None:
+            left = POOL_HEADER_WIDTH
+            self.writer.pool_lanes.append(
+                (xml_id, (left, band[0], self.writer.width - left, band[1]))
+            )
+        return lane
+
+    # Transitions.
+
+    def _transition(self, transition: Transition, lanes: dict[str, ET.Element]) -> None:
+        extra: Json = {k: v for k, v in transition.extra.items() if k != "layout"}
+        kind = "parallelGateway"
+        if transition.is_task:
+            wanted = extra.pop("bpmn", "task")
+            kind = wanted if wanted in TASK_KINDS else "task"
+            if wanted not in TASK_KINDS:
+                extra["bpmn"] = wanted
+        xml_id, faithful = self.ids.own(transition.id, "transition")
+        if not faithful:
+            extra["id"] = transition.id
+        element = ET.Element(_tag(kind), id=xml_id)
+        label = transition.label
+        if label is not None:
+            if label and _is_text(label):
+                element.set("name", label)
+            else:
+                extra["label"] = label
+        _add_extra(element, extra)
+        self.nodes.append(element)
+        self.node_of[transition.id] = xml_id
+        self.entry_of[transition.id] = xml_id
+        centre = _point(transition.extra) or (0.0, 0.0)
+        if transition.is_task:
+            self.writer.element_of[transition.id] = xml_id
+            self.writer.process_of_task[transition.id] = self.element
+            self._shape(xml_id, centre, (TASK_WIDTH, TASK_HEIGHT))
+            lane = lanes.get(transition.performer or "")
+            if lane is not None:
+                ET.SubElement(lane, _tag("flowNodeRef")).text = xml_id
+            if len(self.inputs[transition.id]) > 1:
+                # BPMN merges flows into a task; the net's task waits for all its inputs.
+                join = self.ids.fresh(f"{xml_id}_join")
+                self.nodes.append(ET.Element(_tag("parallelGateway"), id=join))
+                left = centre[0] - TASK_WIDTH / 2 - JOIN_SIZE / 2 - 2
+                self._shape(join, (left, centre[1]), (JOIN_SIZE, JOIN_SIZE))
+                self._flow(join, xml_id)
+                self.entry_of[transition.id] = join
+        else:
+            self._shape(xml_id, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
+
+    # Places.
+
+    def _place(self, place: Place) -> None:
+        extra: Json = {k: v for k, v in place.extra.items() if k != "layout"}
+        if place.tokens is not None:
+            extra["tokens"] = place.tokens
+        name = extra.pop("name", None)
+        if name is not None and not (isinstance(name, str) and name and _is_text(name)):
+            extra["name"] = name
+            name = None
+        producers = [self.node_of[t] for t in self.producers[place.id]]
+        consumers = [self.entry_of[t] for t in self.consumers[place.id]]
+        centre = _point(place.extra) or (0.0, 0.0)
+
+        def carry(element: ET.Element, faithful: bool) -> None:
+            """The element that stands for the place takes its name and data."""
+            data = dict(extra) if faithful else {**extra, "id": place.id}
+            if name is not None:
+                element.set("name", name)
+            _add_extra(element, data)
+
+        if not producers:
+            event, faithful = self.ids.own(place.id, f"{place.id}_start")
+            start = self._node("startEvent", event)
+            carry(start, faithful)
+            if len(consumers) > 1:
+                split = self.ids.fresh(f"{event}_split")
+                self._node("exclusiveGateway", split)
+                self._shape(event, (centre[0] - 25, centre[1]), (EVENT_SIZE, EVENT_SIZE))
+                self._shape(split, (centre[0] + 25, centre[1]), (GATEWAY_SIZE, GATEWAY_SIZE))
+                self._flow(event, split)
+                for consumer in consumers:
+                    self._flow(split, consumer)
+            else:
+                self._shape(event, centre, (EVENT_SIZE, EVENT_SIZE))
+                for consumer in consumers:
+                    self._flow(event, consumer)
+        elif not consumers:
+            event, faithful = self.ids.own(place.id, f"{place.id}_end")
+            carry(self._node("endEvent", event), faithful)
+            self._shape(event, centre, (EVENT_SIZE, EVENT_SIZE))
+            for producer in producers:
+                self._flow(producer, event)
+        elif len(producers) == 1 and len(consumers) == 1:
+            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            carry(self._flow(producers[0], consumers[0], flow_id), faithful)
+        elif len(producers) == 1:  # a choice: the flow into the gateway is the place
+            split = self.ids.fresh(f"{place.id}_split")
+            self._node("exclusiveGateway", split)
+            self._shape(split, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
+            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            carry(self._flow(producers[0], split, flow_id), faithful)
+            for consumer in consumers:
+                self._flow(split, consumer)
+        elif len(consumers) == 1:  # a merge: the flow out of the gateway is the place
+            merge = self.ids.fresh(f"{place.id}_merge")
+            self._node("exclusiveGateway", merge)
+            self._shape(merge, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
+            for producer in producers:
+                self._flow(producer, merge)
+            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            carry(self._flow(merge, consumers[0], flow_id), faithful)
+        else:
+            gateway, faithful = self.ids.own(place.id, f"{place.id}_gateway")
+            carry(self._node("exclusiveGateway", gateway), faithful)
+            self._shape(gateway, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
+            for producer in producers:
+                self._flow(producer, gateway)
+            for consumer in consumers:
+                self._flow(gateway, consumer)
+
+    def _node(self, kind: str, xml_id: str) -> ET.Element:
+        element = ET.Element(_tag(kind), id=xml_id)
+        self.nodes.append(element)
+        return element
+
+    def _flow(self, source: str, target: str, flow_id: str | None = None) -> ET.Element:
+        flow_id = flow_id or self.ids.fresh(f"flow_{source}_{target}")
+        flow = ET.Element(_tag("sequenceFlow"), id=flow_id, sourceRef=source, targetRef=target)
+        self.flows.append(flow)
+        self.writer.edges.append((flow_id, source, target))
+        return flow
+
+    def _shape(self, element: str, centre: tuple[float, float], size: tuple[float, float]) -> None:
+        self.writer.shapes.append(_Shape(element, centre, size))
+
+
+def _add_extra(element: ET.Element, data: Json) -> None:
+    """The keys BPMN cannot carry, as JSON in `<extensionElements><hrc:extra>`.
+
+    ASCII-escaped JSON, so any string (even one XML cannot hold) survives.
+    """
+    if not data:
+        return
+    holder = ET.Element(_tag("extensionElements"))
+    ET.SubElement(holder, _tag("extra", HRC_NAMESPACE)).text = json.dumps(
+        data, ensure_ascii=True, sort_keys=True
+    )
+    element.insert(0, holder)  # extensionElements comes first in every BPMN element
+
+
+def _waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
+    """Right side to left side, bending half-way; an edge back to the left goes round below."""
+    (sx, sy), (sw, sh) = source.centre, source.size
+    (tx, ty), (tw, th) = target.centre, target.size
+    start, end = sx + sw / 2, tx - tw / 2
+    if end > start:
+        if sy == ty:
+            return [(start, sy), (end, ty)]
+        middle = (start + end) / 2
+        return [(start, sy), (middle, sy), (middle, ty), (end, ty)]
+    below = max(sy + sh / 2, ty + th / 2) + 20
+    return [(sx, sy + sh / 2), (sx, below), (tx, below), (tx, ty + th / 2)]
+
+
+def _num(value: float) -> str:
+    return f"{value:.2f}".rstrip("0").rstrip(".")
