@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 from channels.layers import get_channel_layer
 from django.db import connections, transaction
 
-from hrc.live.events import CaseData, IncidentData, LiveEvent, WorkItemData
+from hrc.live.events import CaseData, CobotStateData, IncidentData, LiveEvent, WorkItemData
 
 if TYPE_CHECKING:
     from django.contrib.auth.models import User
@@ -134,6 +134,21 @@ def case_event_on_commit(
     )
     if item is not None and item.cobot_id is not None and item.kind != "operator":
         cobot_queue_on_commit(item.cobot_id)
+
+
+async def send_cobot_state(state: CobotStateData, *, organisation: int, cell: str) -> None:
+    """Sends a cobot's gateway state now (the monitor's; no transaction is involved)."""
+    layer = get_channel_layer()
+    if layer is None:
+        return
+    message = {
+        "type": CHANNEL_MESSAGE_TYPE,
+        "organisation": organisation,
+        "cell": cell,
+        "event": {"type": "cobot-state", "states": [state]},
+    }
+    for group in cell_groups(organisation, cell):
+        await layer.group_send(group, message)
 
 
 # Payloads from objects in hand ---------------------------------------------------------

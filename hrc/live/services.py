@@ -19,7 +19,7 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
 from django.contrib.auth.models import User
-from django.db import IntegrityError, transaction
+from django.db import IntegrityError, connections, transaction
 from django.db.models import Q
 from django.utils import timezone
 
@@ -130,8 +130,15 @@ def _command_all(cobots: list[Cobot], command: Callable[[Cobot], str]) -> dict[s
     """Runs `command` on every cobot at once; {cobot id: problem} for those that did not do it."""
     if not cobots:
         return {}
+
+    def run(cobot: Cobot) -> str:
+        try:
+            return command(cobot)
+        finally:
+            connections.close_all()  # the pool thread's own connection, if it opened one
+
     with ThreadPoolExecutor(max_workers=min(8, len(cobots))) as pool:
-        outcomes = list(pool.map(command, cobots))
+        outcomes = list(pool.map(run, cobots))
     return {str(c.pk): problem for c, problem in zip(cobots, outcomes, strict=True) if problem}
 
 
