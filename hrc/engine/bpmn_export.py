@@ -46,7 +46,7 @@ from hrc.engine.bpmn import (
 from hrc.engine.bpmn_net import TASK_KINDS
 from hrc.engine.document import FormatError
 from hrc.engine.issues import error
-from hrc.engine.layout import TASK_HEIGHT, TASK_WIDTH, lay_out_pattern
+from hrc.engine.layout import TASK_HEIGHT, TASK_WIDTH, is_laid_out, lay_out_pattern
 from hrc.engine.model import Actor, Pattern, Place, Process, Transition
 from hrc.engine.rules import check_rules
 
@@ -74,7 +74,7 @@ UNREPRESENTABLE = ("duplicate-id", "unknown-node", "arc-kind")
 def pattern_to_bpmn(pattern: Pattern) -> str:
     """The BPMN 2.0 XML of a pattern; raises FormatError when BPMN cannot represent it."""
     _check_representable(pattern)
-    if not _has_layout(pattern):
+    if not is_laid_out(pattern):
         pattern = lay_out_pattern(pattern)
     return _Writer(pattern).text()
 
@@ -102,29 +102,6 @@ def _number(value: object) -> float | None:
     if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
         return float(value)
     return None
-
-
-def _is_number(value: object) -> bool:
-    return _number(value) is not None
-
-
-def _has_layout(pattern: Pattern) -> bool:
-    """Whether every node has a position and the document its lanes, as `lay_out` writes them."""
-    layout = pattern.extra.get("layout")
-    if not isinstance(layout, dict) or not _is_number(layout.get("width")):
-        return False
-    lanes = layout.get("lanes")
-    if not isinstance(lanes, list) or not all(
-        isinstance(lane, dict) and _is_number(lane.get("y")) and _is_number(lane.get("height"))
-        for lane in lanes
-    ):
-        return False
-    drawn = {lane.get("actor") for lane in lanes}
-    if any(actor.id not in drawn for actor in pattern.actors):
-        return False
-    return all(
-        _point(node.extra) is not None for process in pattern.processes for node in _nodes(process)
-    )
 
 
 def _nodes(process: Process) -> list[Place | Transition]:

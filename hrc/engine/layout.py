@@ -33,6 +33,7 @@ out imported models (PNML, BPMN) with the same code the editor asks for.
 """
 
 import heapq
+import math
 import re
 from collections import defaultdict
 from collections.abc import Iterable
@@ -99,6 +100,34 @@ def lay_out_pattern(pattern: Pattern) -> Pattern:
         processes.append(replace(process, places=places, transitions=transitions))
     extra = {**pattern.extra, "layout": plan.document_layout()}
     return replace(pattern, processes=tuple(processes), extra=extra)
+
+
+def is_laid_out(pattern: Pattern) -> bool:
+    """Whether every node has a position and every actor a lane, as `lay_out` writes them."""
+    layout = pattern.extra.get("layout")
+    if not isinstance(layout, dict) or not _is_number(layout.get("width")):
+        return False
+    lanes = layout.get("lanes")
+    if not isinstance(lanes, list) or not all(
+        isinstance(lane, dict) and _is_number(lane.get("y")) and _is_number(lane.get("height"))
+        for lane in lanes
+    ):
+        return False
+    drawn = {lane.get("actor") for lane in lanes}
+    if any(actor.id not in drawn for actor in pattern.actors):
+        return False
+    extras = [p.extra for process in pattern.processes for p in process.places]
+    extras += [t.extra for process in pattern.processes for t in process.transitions]
+    return all(
+        isinstance(point := extra.get("layout"), dict)
+        and _is_number(point.get("x"))
+        and _is_number(point.get("y"))
+        for extra in extras
+    )
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def natural_key(text: str) -> tuple[tuple[tuple[int, int, str], ...], str]:

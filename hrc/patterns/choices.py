@@ -10,3 +10,5 @@ class DocumentFormat(models.TextChoices):
     JSON = "json", "hrc-pattern/1 (JSON)"
     # PNML, the Petri net exchange standard: the nets travel, actors and constraints as tool data.
     PNML = "pnml", "PNML (XML)"
+    # BPMN 2.0 (Dijkman, Dumas and Ouyang's mapping): tasks in lanes, gateways, a diagram for other tools.
+    BPMN = "bpmn", "BPMN 2.0 (XML)"

@@ -4,6 +4,24 @@ Every other module of the app goes through these functions, so a change in
 the engine's interface is absorbed here.
 """
 
+__all__ = [
+    "FormatError",
+    "NoExecutionNet",
+    "check_report",
+    "execution_net",
+    "from_bpmn",
+    "from_pnml",
+    "is_publishable",
+    "laid_out",
+    "looks_like_bpmn",
+    "read_draft",
+    "starter_document",
+    "storage_problem",
+    "to_bpmn",
+    "to_pnml",
+    "validate_storable_document",
+]
+
 import math
 from collections.abc import Iterator
 from typing import Any
@@ -11,8 +29,14 @@ from typing import Any
 from django.core.exceptions import ValidationError
 
 from hrc.engine import FORMAT, FormatError, check_document, read_pattern, write_pattern
+from hrc.engine.bpmn import bpmn_to_pattern, is_bpmn
+from hrc.engine.bpmn_export import pattern_to_bpmn
+from hrc.engine.issues import Issue
+from hrc.engine.layout import is_laid_out, lay_out_pattern
 from hrc.engine.model import Pattern
 from hrc.engine.pnml import pattern_to_pnml, pnml_to_pattern
+from hrc.engine.rules import STRUCTURAL_CODES, check_rules
+from hrc.engine.tokengame import execution_net_json
 
 # Deeper than any real pattern document (about 6 levels, plus the editor's layout),
 # shallow enough that nothing downstream (json, jsonb, the serializers) recurses too far.
@@ -53,14 +77,64 @@ def starter_document(name: str) -> dict[str, Any]:
     }
 
 
+class NoExecutionNet(Exception):
+    """The document breaks structural rules, so it has no execution net; `issues` says which."""
+
+    def __init__(self, issues: list[Issue]) -> None:
+        super().__init__("; ".join(issue.message for issue in issues))
+        self.issues = issues
+
+
 def from_pnml(text: bytes) -> dict[str, Any]:
-    """An `hrc-pattern/1` document from PNML; raises FormatError on bad or hostile XML."""
-    return write_pattern(pnml_to_pattern(text))
+    """An `hrc-pattern/1` document from PNML, laid out unless it brings positions for every node.
+
+    Raises FormatError on bad or hostile XML.
+    """
+    return write_pattern(_drawn(pnml_to_pattern(text)))
+
+
+def from_bpmn(text: bytes) -> dict[str, Any]:
+    """An `hrc-pattern/1` document from BPMN 2.0, laid out in its actors' lanes.
+
+    Raises FormatError naming the element on bad or hostile XML and on what the mapping does not cover.
+    """
+    return write_pattern(_drawn(bpmn_to_pattern(text)))
+
+
+def looks_like_bpmn(text: bytes) -> bool:
+    """Whether an XML body is BPMN (root `<definitions>` in BPMN's namespace) rather than PNML."""
+    return is_bpmn(text)
 
 
 def to_pnml(document: object) -> str:
     """The PNML text of a stored document; raises FormatError when it is unreadable."""
     return pattern_to_pnml(read_pattern(document))
+
+
+def to_bpmn(document: object) -> str:
+    """The BPMN 2.0 text of a stored document; raises FormatError when BPMN cannot say it."""
+    return pattern_to_bpmn(read_pattern(document))
+
+
+def laid_out(document: object) -> dict[str, Any]:
+    """The document with every node placed in its actor's lane; raises FormatError on a bad shape."""
+    return write_pattern(lay_out_pattern(read_pattern(document)))
+
+
+def execution_net(document: object) -> dict[str, Any]:
+    """The execution net the token game plays (engine.tokengame).
+
+    Raises FormatError on a bad shape and NoExecutionNet when a structural rule is broken.
+    """
+    pattern = read_pattern(document)
+    broken = [issue for issue in check_rules(pattern) if issue.code in STRUCTURAL_CODES]
+    if broken:
+        raise NoExecutionNet(broken)
+    return execution_net_json(pattern)
+
+
+def _drawn(pattern: Pattern) -> Pattern:
+    return pattern if is_laid_out(pattern) else lay_out_pattern(pattern)
 
 
 def storage_problem(value: object) -> str | None:

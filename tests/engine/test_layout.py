@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from hrc.engine.document import FormatError, read_pattern, write_pattern
 from hrc.engine.graph import reachable
-from hrc.engine.layout import lay_out, natural_key
+from hrc.engine.layout import is_laid_out, lay_out, natural_key
 from tests.engine.builders import EXAMPLES, document, process, two_lanes
 from tests.engine.strategies import decorated, patterns
 
@@ -363,3 +363,15 @@ def test_natural_order_puts_p2_before_p10() -> None:
 def test_the_written_pattern_round_trips() -> None:
     laid_out = lay_out(two_lanes([("to1", "tc2", "time")]))
     assert write_pattern(read_pattern(laid_out)) == laid_out
+
+
+def test_is_laid_out_tells_a_drawn_model_from_one_without_positions() -> None:
+    original = _load(EXAMPLES / "synch_1o1c_assembly.json")
+    laid_out = lay_out(original)
+    assert is_laid_out(read_pattern(laid_out))
+    assert not is_laid_out(read_pattern(original))
+    laid_out["actors"].append({"id": "newcomer", "type": "operator"})
+    assert not is_laid_out(read_pattern(laid_out))  # a new actor has no lane yet
+    del laid_out["actors"][-1]
+    laid_out["processes"][0]["places"][0]["layout"] = {"x": "left"}
+    assert not is_laid_out(read_pattern(laid_out))

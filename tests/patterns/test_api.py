@@ -473,12 +473,12 @@ def test_a_published_version_exports_under_its_number(
 def test_an_unknown_format_is_a_400_naming_the_formats(
     engineer_client: APIClient, pattern: PatternModel
 ) -> None:
-    exported = engineer_client.get(f"/api/patterns/{pattern.pk}/export/?format=bpmn")
+    exported = engineer_client.get(f"/api/patterns/{pattern.pk}/export/?format=yaml")
     assert exported.status_code == 400
-    assert "json or pnml" in exported.json()["detail"]
-    imported = _post_json(engineer_client, "/api/patterns/import/?format=bpmn", {})
+    assert "json, pnml or bpmn" in exported.json()["detail"]
+    imported = _post_json(engineer_client, "/api/patterns/import/?format=yaml", {})
     assert imported.status_code == 400
-    assert "json or pnml" in imported.data["detail"]
+    assert "json, pnml or bpmn" in imported.data["detail"]
 
 
 @pytest.mark.parametrize(

@@ -140,3 +140,65 @@ class DocumentErrorSerializer(_WithIssueLists):
     issue_lists = ("errors",)
 
     detail = serializers.CharField()
+
+
+class _Labelled(serializers.Serializer[dict[str, Any]]):
+    """Adds `label` in get_fields: a class attribute of that name would shadow Field.label."""
+
+    label_help = ""
+
+    def get_fields(self) -> dict[str, serializers.Field[Any, Any, Any, Any]]:
+        fields = super().get_fields()
+        fields = {
+            "id": fields.pop("id"),
+            "label": serializers.CharField(help_text=self.label_help),
+        } | fields
+        return fields
+
+
+class NetPlaceSerializer(_Labelled):
+    label_help = "How the editor can name it."
+
+    id = serializers.CharField(help_text="p2, running:tc1, time:to1>tc2, func-start:tc2>to1, ...")
+    tokens = serializers.IntegerField(help_text="In the initial marking.")
+    kind = serializers.ChoiceField(
+        ["flow", "busy", "constraint"],
+        help_text="flow: a place of the pattern; busy: marked while a task runs; constraint: added by a constraint.",
+    )
+    of = serializers.JSONField(
+        help_text=(
+            "flow: the place's id; busy: the task's id; constraint: {constraint: index in the "
+            "document's constraints, type, role: time | func-start | func-done, from, to}."
+        )
+    )
+    needs = serializers.CharField(
+        required=False, help_text="Constraint places: what the task that takes the token waits for."
+    )
+
+
+class NetTransitionSerializer(_Labelled):
+    label_help = "As a firing sequence (a witness) names it: start tc1, t1."
+
+    id = serializers.CharField(help_text="start:tc1, complete:tc1, or a silent transition's id.")
+    kind = serializers.ChoiceField(["start", "complete", "silent"])
+    task = serializers.CharField(help_text="The pattern transition it belongs to.")
+    performer = serializers.CharField(allow_null=True)
+
+
+class ExecutionNetSerializer(serializers.Serializer[dict[str, Any]]):
+    """The execution net of a pattern (hrc/engine/tokengame.py) for the token game."""
+
+    places = NetPlaceSerializer(many=True)
+    transitions = NetTransitionSerializer(many=True)
+    arcs = serializers.ListField(
+        child=serializers.ListField(child=serializers.CharField(), min_length=2, max_length=2),
+        help_text="[from, to]; each moves one token.",
+    )
+    initial = serializers.DictField(child=serializers.IntegerField(), help_text="Place -> tokens.")
+    final = serializers.DictField(
+        child=serializers.IntegerField(), help_text="The marking of a properly ended case."
+    )
+    ignored = serializers.ListField(
+        child=serializers.CharField(),
+        help_text="Constraint places, which proper completion does not look at.",
+    )

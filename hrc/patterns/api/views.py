@@ -1,4 +1,8 @@
-"""Patterns: CRUD of drafts, check, publish, versions, import and export.
+"""Patterns: CRUD of drafts, check, publish, versions, import and export; the editor's helpers.
+
+The editor's helpers (check-document, layout, execution-net) take an unsaved
+`hrc-pattern/1` document in the body and store nothing. Unlike check, they
+are for the people who edit patterns: engineers and admins.
 
 Every queryset starts from the selectors, which see only the user's
 organisations: an outsider gets 404, a user without membership an empty list.
@@ -31,6 +35,7 @@ from hrc.patterns import services
 from hrc.patterns.api.serializers import (
     CheckReportSerializer,
     DocumentErrorSerializer,
+    ExecutionNetSerializer,
     PatternSerializer,
     PatternSummarySerializer,
     PatternVersionSerializer,
@@ -38,7 +43,19 @@ from hrc.patterns.api.serializers import (
     PublishRefusedSerializer,
 )
 from hrc.patterns.choices import DocumentFormat
-from hrc.patterns.documents import check_report, from_pnml, to_pnml
+from hrc.patterns.documents import (
+    FormatError,
+    NoExecutionNet,
+    check_report,
+    execution_net,
+    from_bpmn,
+    from_pnml,
+    laid_out,
+    looks_like_bpmn,
+    read_draft,
+    to_bpmn,
+    to_pnml,
+)
 from hrc.patterns.models import PatternModel, PatternVersion
 from hrc.patterns.selectors import patterns_visible_to, versions_of, versions_visible_to
 
@@ -49,7 +66,11 @@ FORMAT_PARAMETER = OpenApiParameter(
     "format",
     str,
     enum=list(DocumentFormat.values),
-    description="json: hrc-pattern/1 (default); pnml: PNML XML.",
+    description="json: hrc-pattern/1 (default); pnml: PNML XML; bpmn: BPMN 2.0 XML.",
+)
+DOCUMENT_REQUEST = {"application/json": OpenApiTypes.OBJECT}
+DOCUMENT_REFUSED = OpenApiResponse(
+    DocumentErrorSerializer, description="The body is not a readable hrc-pattern/1 document."
 )
 EXPORT_RESPONSES = {
     (200, "application/json"): OpenApiTypes.OBJECT,
@@ -160,16 +181,25 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     )
     @action(detail=False, methods=["post"], url_path="import", url_name="import")
     def import_document(self, request: Request) -> Response:
-        """Creates a pattern from an hrc-pattern/1 document or a PNML file.
+        """Creates a pattern from an hrc-pattern/1 document, a PNML file or a BPMN 2.0 file.
 
-        The format is `?format=`, or else follows the content type (XML means PNML).
+        The format is `?format=`, or else follows the content type: XML is BPMN when
+        its root is BPMN's `<definitions>`, PNML otherwise. PNML and BPMN models are
+        laid out in their actors' lanes unless they bring a position for every node.
+        A file that cannot be read, or a BPMN feature the mapping does not cover, is a
+        400 naming the element, and nothing is created.
         """
         organisation = target_organisation(request, _id_param(request, "organisation"))
         xml_body = (request.content_type or "").split(";")[0].strip() in XML_MEDIA_TYPES
-        default = DocumentFormat.PNML if xml_body else DocumentFormat.JSON
         body = read_body(request._request)
-        if _format_param(request, default) == DocumentFormat.PNML:
+        default = DocumentFormat.JSON
+        if xml_body:
+            default = DocumentFormat.BPMN if looks_like_bpmn(body) else DocumentFormat.PNML
+        document_format = _format_param(request, default)
+        if document_format == DocumentFormat.PNML:
             document: object = from_pnml(body)
+        elif document_format == DocumentFormat.BPMN:
+            document = from_bpmn(body)
         else:
             document = parse_json_body(body)
         pattern = services.import_pattern(
@@ -180,9 +210,76 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     @extend_schema(parameters=[FORMAT_PARAMETER], responses=EXPORT_RESPONSES)
     @action(detail=True, methods=["get"])
     def export(self, request: Request, pk: str | None = None) -> HttpResponse:
-        """The draft as a file: hrc-pattern/1 JSON or PNML."""
+        """The draft as a file: hrc-pattern/1 JSON, PNML or BPMN 2.0 (with a diagram)."""
         pattern = self.get_object()
         return _export(pattern.draft, slugify(pattern.name) or "pattern", _format_param(request))
+
+    # The editor's helpers: a document in, an answer out, nothing stored.
+
+    @extend_schema(
+        request=DOCUMENT_REQUEST, responses={200: CheckReportSerializer, 400: DOCUMENT_REFUSED}
+    )
+    @action(detail=False, methods=["post"], url_path="check-document", url_name="check-document")
+    def check_document(self, request: Request) -> Response:
+        """Checks an unsaved hrc-pattern/1 document: the same report as POST /patterns/{id}/check/.
+
+        The editor calls this as the model changes. A body that is not a readable
+        hrc-pattern/1 document is a 400 listing what is wrong with its shape.
+        """
+        document = request.data
+        read_draft(document)  # a shape error is the request's fault: 400
+        return Response(check_report(document))
+
+    @extend_schema(
+        request=DOCUMENT_REQUEST,
+        responses={
+            200: OpenApiResponse(
+                OpenApiTypes.OBJECT,
+                description=(
+                    "The document with `layout: {x, y}` (centres, pixels) on every place and "
+                    "transition and `layout: {lanes: [{actor, y, height}], width, height, sizes}` "
+                    "on the document; nothing else changed."
+                ),
+            ),
+            400: DOCUMENT_REFUSED,
+        },
+    )
+    @action(detail=False, methods=["post"])
+    def layout(self, request: Request) -> Response:
+        """Lays the document out: left to right by precedence, each actor's tasks in its lane."""
+        return Response(laid_out(request.data))
+
+    @extend_schema(
+        request=DOCUMENT_REQUEST,
+        responses={
+            200: ExecutionNetSerializer,
+            400: OpenApiResponse(
+                DocumentErrorSerializer,
+                description="Not a readable document, or a structural rule is broken (the issues).",
+            ),
+        },
+    )
+    @action(detail=False, methods=["post"], url_path="execution-net", url_name="execution-net")
+    def execution_net(self, request: Request) -> Response:
+        """The execution net the token game plays: the net the check explores and cases fire.
+
+        Every task is split into `start:<task>` and `complete:<task>` around a
+        `running:<task>` place; a time constraint adds a place from one task's
+        completion to the other's start, a func constraint two; silent steps stay
+        one transition. Each place and transition says which element of the
+        pattern it belongs to (see hrc/engine/tokengame.py). A document that breaks
+        a structural rule has no execution net: 400 with the rules' issues.
+        """
+        try:
+            net = execution_net(request.data)
+        except NoExecutionNet as exc:
+            raise Rejected(
+                {
+                    "detail": f"The model breaks structural rules, so it cannot be played: {exc}",
+                    "errors": [issue.as_dict() for issue in exc.issues],
+                }
+            ) from None
+        return Response(net)
 
 
 class PatternVersionViewSet(viewsets.ReadOnlyModelViewSet[PatternVersion]):
@@ -209,7 +306,7 @@ class PatternVersionViewSet(viewsets.ReadOnlyModelViewSet[PatternVersion]):
     @extend_schema(parameters=[FORMAT_PARAMETER], responses=EXPORT_RESPONSES)
     @action(detail=True, methods=["get"])
     def export(self, request: Request, pk: str | None = None) -> HttpResponse:
-        """The version's document as a file: hrc-pattern/1 JSON or PNML."""
+        """The version's document as a file: hrc-pattern/1 JSON, PNML or BPMN 2.0 (with a diagram)."""
         version = self.get_object()
         filename = f"{slugify(version.pattern.name) or 'pattern'}-v{version.number}"
         return _export(version.document, filename, _format_param(request))
@@ -219,6 +316,18 @@ def _export(document: object, filename: str, document_format: str) -> HttpRespon
     if document_format == DocumentFormat.PNML:
         response = HttpResponse(to_pnml(document), content_type="application/xml; charset=utf-8")
         extension = "pnml"
+    elif document_format == DocumentFormat.BPMN:
+        try:
+            text = to_bpmn(document)
+        except FormatError as exc:
+            raise Rejected(
+                {
+                    "detail": f"The model cannot be exported as BPMN: {exc}",
+                    "errors": [issue.as_dict() for issue in exc.issues],
+                }
+            ) from None
+        response = HttpResponse(text, content_type="application/xml; charset=utf-8")
+        extension = "bpmn"
     else:
         text = json.dumps(document, indent=2, ensure_ascii=False)
         response = HttpResponse(text, content_type="application/json; charset=utf-8")
@@ -231,7 +340,8 @@ def _format_param(request: Request, default: str = DocumentFormat.JSON) -> str:
     """`?format=`, one of DocumentFormat; a 400 that lists them for anything else."""
     value = request.query_params.get("format", default)
     if value not in DocumentFormat.values:
-        allowed = " or ".join(DocumentFormat.values)
+        *others, last = DocumentFormat.values
+        allowed = f"{', '.join(others)} or {last}"
         raise Rejected({"detail": f"Unknown format {value[:40]!r}: use {allowed}."})
     return value
 
