@@ -1,0 +1,6 @@
+import ConstraintHighlight from "./ConstraintHighlight";
+
+export default {
+  __init__: ["constraintHighlight"],
+  constraintHighlight: ["type", ConstraintHighlight],
+};

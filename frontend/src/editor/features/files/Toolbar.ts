@@ -1,0 +1,104 @@
+/** The toolbar above the canvas: name, undo/redo, save, publish, import, export, layout, token game. */
+
+import type CommandStack from "diagram-js/lib/command/CommandStack";
+import type EventBus from "diagram-js/lib/core/EventBus";
+
+import type AutoLayout from "../layout/AutoLayout";
+import type TokenGameMode from "../token-game/TokenGameMode";
+import type PatternFiles from "./PatternFiles";
+import type { ExportFormat, FilesMessage } from "./PatternFiles";
+
+export default class Toolbar {
+  static $inject = ["eventBus", "config.shell", "patternFiles", "commandStack", "autoLayout", "tokenGame", "config.pattern"];
+
+  constructor(
+    eventBus: EventBus,
+    shell: { toolbar: HTMLElement },
+    files: PatternFiles,
+    commandStack: CommandStack,
+    autoLayout: AutoLayout,
+    tokenGame: TokenGameMode,
+    pattern: { canWrite: boolean },
+  ) {
+    const bar = shell.toolbar;
+    const name = document.createElement("input");
+    name.className = "hrc-name";
+    name.setAttribute("aria-label", "Pattern name");
+    name.addEventListener("change", () => {
+      try {
+        files.rename(name.value);
+      } catch (error) {
+        show({ text: (error as Error).message, kind: "error" });
+      }
+    });
+    bar.appendChild(name);
+    const button = (text: string, title: string, run: () => unknown) => {
+      const node = document.createElement("button");
+      node.type = "button";
+      node.textContent = text;
+      node.title = title;
+      node.addEventListener("click", () => void run());
+      bar.appendChild(node);
+      return node;
+    };
+    const undo = button("Undo", "Undo (Ctrl+Z)", () => commandStack.undo());
+    const redo = button("Redo", "Redo (Ctrl+Y)", () => commandStack.redo());
+    const save = button("Save", "Save the draft", () => files.save());
+    const publish = button("Publish", "Publish the draft as a new version", () => files.publish());
+    publish.classList.add("primary");
+    button("Layout", "Lay the model out in its actor lanes", () => autoLayout.layout().catch((error: Error) => show({ text: `Layout failed: ${error.message}`, kind: "error" })));
+    button("Token game", "Play the model: fire tasks by click", () => tokenGame.start().catch((error: Error) => show({ text: `The token game could not start: ${error.message}`, kind: "error" })));
+
+    const importLabel = document.createElement("label");
+    importLabel.className = "button hrc-import";
+    importLabel.textContent = "Import…";
+    const picker = document.createElement("input");
+    picker.type = "file";
+    picker.accept = ".json,.pnml,.xml,.bpmn";
+    picker.setAttribute("aria-label", "Import a file");
+    picker.addEventListener("change", () => {
+      const file = picker.files?.[0];
+      picker.value = "";
+      if (file) void files.importFile(file);
+    });
+    importLabel.appendChild(picker);
+    bar.appendChild(importLabel);
+
+    const exporter = document.createElement("select");
+    exporter.setAttribute("aria-label", "Export");
+    for (const [value, text] of [["", "Export…"], ["json", "hrc-pattern/1 (.json)"], ["pnml", "PNML (.pnml)"], ["bpmn", "BPMN 2.0 (.bpmn)"]]) {
+      const option = document.createElement("option");
+      option.value = value;
+      option.textContent = text;
+      exporter.appendChild(option);
+    }
+    exporter.addEventListener("change", () => {
+      const format = exporter.value as ExportFormat;
+      exporter.value = "";
+      if (format) void files.exportAs(format);
+    });
+    bar.appendChild(exporter);
+
+    const status = document.createElement("output");
+    status.className = "hrc-status";
+    status.setAttribute("role", "status");
+    bar.appendChild(status);
+    const show = (message: FilesMessage) => {
+      status.textContent = message.text;
+      status.dataset.kind = message.kind;
+      status.setAttribute("role", message.kind === "error" ? "alert" : "status");
+    };
+    eventBus.on("files.message", show);
+    eventBus.on(["files.changed", "commandStack.changed", "import.done"], () => {
+      name.value = files.name;
+      undo.disabled = !commandStack.canUndo();
+      redo.disabled = !commandStack.canRedo();
+      save.disabled = !pattern.canWrite || files.busy;
+      publish.disabled = !pattern.canWrite || files.busy;
+      bar.dataset.dirty = String(files.dirty);
+    });
+    window.addEventListener("beforeunload", (event) => {
+      if (files.dirty) event.preventDefault();
+    });
+  }
+}

@@ -1,0 +1,156 @@
+/**
+ * The properties of the selected element beside the canvas, or of the
+ * pattern when nothing is selected. Every change is a command (undoable).
+ */
+
+import type Canvas from "diagram-js/lib/core/Canvas";
+import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
+import type EventBus from "diagram-js/lib/core/EventBus";
+import type Selection from "diagram-js/lib/features/selection/Selection";
+import type { Connection, Shape } from "diagram-js/lib/model/Types";
+
+import { PATTERN_NAMES } from "../../model/document";
+import { idProblem } from "../../model/ids";
+import { performerRefusal } from "../../model/rules";
+import { CONSTRAINT_TYPES } from "../../model/document";
+import { isLane, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
+import type PatternElementFactory from "../../core/PatternElementFactory";
+import type PatternModeling from "../modeling/PatternModeling";
+import { add, field, heading, note, select } from "./fields";
+import { taskSection } from "./TaskSection";
+
+type Element = Shape | Connection;
+
+export default class PropertiesPanel {
+  static $inject = ["eventBus", "config.shell", "selection", "elementRegistry", "canvas", "modeling", "elementFactory"];
+
+  readonly panel: HTMLElement;
+
+  constructor(
+    eventBus: EventBus,
+    shell: { side: HTMLElement },
+    private readonly selection: Selection,
+    private readonly elementRegistry: ElementRegistry,
+    private readonly canvas: Canvas,
+    private readonly modeling: PatternModeling,
+    private readonly elementFactory: PatternElementFactory,
+  ) {
+    this.panel = add(shell.side, "section", "hrc-properties");
+    this.panel.setAttribute("aria-label", "Properties");
+    eventBus.on(["selection.changed", "import.done", "commandStack.changed"], () => this.render());
+  }
+
+  render(): void {
+    const selected = this.selection.get() as Element[];
+    this.panel.replaceChildren();
+    const element = selected.length === 1 ? selected[0] : null;
+    const object = objectOf(element) as PatternObject | undefined;
+    if (selected.length > 1) return note(this.panel, `${selected.length} elements selected.`);
+    if (!element || !object || object.kind === "root") return this.patternSection();
+    if (object.kind === "place" || object.kind === "transition") this.nodeSection(element as Shape, object);
+    else if (object.kind === "lane") this.laneSection(element as Shape);
+    else if (object.kind === "constraint") this.constraintSection(element as Connection, object);
+    else this.arcSection(element as Connection);
+  }
+
+  private patternSection(): void {
+    const root = this.canvas.getRootElement() as Shape;
+    const object = objectOf(root) as RootObject | undefined;
+    if (!object) return;
+    heading(this.panel, "Pattern");
+    select(this.panel, "Declared pattern", String(object.data.declared_pattern ?? ""), [["", "none (classify only)"], ...PATTERN_NAMES.map((name): [string, string] => [name, name])], (value) =>
+      this.modeling.updateData(root, { declared_pattern: value || undefined }),
+    );
+    object.processes.forEach((process, index) => {
+      field(this.panel, {
+        label: `Workpiece of net ${String(process.id)}`,
+        value: String(process.workpiece ?? ""),
+        commit: (text) => {
+          const processes = object.processes.map((p, i) => (i === index ? { ...p, workpiece: text.trim() || undefined } : p));
+          this.modeling.updateData(root, {}, { processes: processes.map((p) => JSON.parse(JSON.stringify(p))) });
+        },
+      });
+    });
+    note(this.panel, "Select an element to see its properties. Drop tasks in an actor's lane; join two tasks of different actors with a constraint from the task's context pad.");
+  }
+
+  private nodeSection(shape: Shape, object: PatternObject & { kind: "place" | "transition" }): void {
+    const silent = object.kind === "transition" && object.silent;
+    heading(this.panel, object.kind === "place" ? "Place" : silent ? "Silent transition" : "Task");
+    this.idField(shape);
+    field(this.panel, { label: "Label", value: String(object.data.label ?? ""), commit: (text) => this.modeling.updateLabel(shape, text) });
+    if (object.kind === "place") {
+      field(this.panel, { label: "Initial tokens", type: "number", value: String(object.data.tokens ?? 0), commit: (text) => {
+        const tokens = Number(text);
+        if (!Number.isInteger(tokens) || tokens < 0) throw new Error("Tokens are a whole number ≥ 0.");
+        this.modeling.updateData(shape, { tokens: tokens || undefined });
+      } });
+      return;
+    }
+    if (silent) {
+      field(this.panel, { label: "Guard", value: String(object.data.guard ?? ""), hint: "Fires only when this expression over data holds, e.g. data.count > 3", commit: (text) => this.modeling.updateData(shape, { guard: text.trim() || undefined }) });
+      return;
+    }
+    const performer = String(object.data.performer ?? "");
+    const lanes = this.elementRegistry.filter(isLane) as Shape[];
+    select(this.panel, "Actor", performer, lanes.map((lane): [string, string] => [lane.id, `${laneObject(lane).data.type} ${lane.id}`]), (actor) => {
+      const reason = performerRefusal(shape.id, actor, this.constraints(), (task) => (objectOf(this.elementRegistry.get(task)) as { data?: { performer?: string } } | undefined)?.data?.performer);
+      if (reason) throw new Error(reason);
+      const lane = this.elementRegistry.get(actor) as Shape;
+      const y = lane.y + lane.height / 2 - (shape.y + shape.height / 2);
+      this.modeling.moveElements([shape], { x: 0, y: Math.round(y) });
+    });
+    const actor = this.elementRegistry.get(performer);
+    taskSection(this.panel, shape, actor && isLane(actor) ? laneObject(actor).data.type : undefined, this.modeling);
+  }
+
+  private laneSection(shape: Shape): void {
+    const object = laneObject(shape);
+    heading(this.panel, object.data.type === "cobot" ? "Cobot (actor)" : "Operator (actor)");
+    this.idField(shape);
+    field(this.panel, { label: "Name", value: String(object.data.label ?? ""), commit: (text) => this.modeling.updateLabel(shape, text) });
+    select(this.panel, "Kind", object.data.type, [["operator", "operator (a person)"], ["cobot", "cobot"]], (type) => this.modeling.updateData(shape, { type }));
+    if (object.data.type === "cobot") {
+      field(this.panel, { label: "Default program", value: String(object.data.program ?? ""), placeholder: "Coexistence_PickAndPlace", commit: (text) => this.modeling.updateData(shape, { program: text.trim() || undefined }) });
+    }
+    const root = objectOf(this.canvas.getRootElement() as Shape) as RootObject;
+    select(this.panel, "Net (process)", object.process ?? "", root.processes.map((p): [string, string] => [String(p.id), String(p.id)]), (process) => this.modeling.updateData(shape, {}, { process }));
+  }
+
+  private constraintSection(connection: Connection, object: ConstraintObject): void {
+    heading(this.panel, "Constraint");
+    note(this.panel, `From ${connection.source?.id} to ${connection.target?.id}.`);
+    select(this.panel, "Kind", object.data.type, CONSTRAINT_TYPES.map((type): [string, string] => [type, type]), (type) => this.modeling.updateData(connection, { type, interrupt: type === "space" ? object.data.interrupt : undefined }));
+    if (object.data.type === "space") {
+      select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), [["pause", "pauses"], ["slow", "slows down"]], (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));
+    }
+  }
+
+  private arcSection(connection: Connection): void {
+    heading(this.panel, "Arc");
+    note(this.panel, `From ${connection.source?.id} to ${connection.target?.id}.`);
+  }
+
+  private idField(shape: Shape): void {
+    field(this.panel, {
+      label: "Id",
+      value: shape.id,
+      commit: (text) => {
+        const id = text.trim();
+        if (id === shape.id) return;
+        const problem = idProblem(id, this.elementFactory.isTaken);
+        if (problem) throw new Error(problem);
+        this.modeling.updateId(shape, id);
+      },
+    });
+  }
+
+  private constraints(): { from: string; to: string; type: string }[] {
+    return this.elementRegistry
+      .filter((element) => objectOf(element)?.kind === "constraint")
+      .map((element) => {
+        const c = element as Connection;
+        return { from: String(c.source?.id), to: String(c.target?.id), type: (objectOf(c) as ConstraintObject).data.type };
+      });
+  }
+}

@@ -1,0 +1,209 @@
+/**
+ * The token game on the canvas: the server compiles the execution net
+ * (POST /api/patterns/execution-net/); here tokens move on it. A click on a
+ * task starts it, or completes it when it runs; a silent transition fires on
+ * a click. Back and forward step through the firings; a witness from the
+ * check is replayed the same way. Editing is off while the game runs.
+ */
+
+import type Canvas from "diagram-js/lib/core/Canvas";
+import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
+import type EventBus from "diagram-js/lib/core/EventBus";
+import type Overlays from "diagram-js/lib/features/overlays/Overlays";
+import type { Connection, Shape } from "diagram-js/lib/model/Types";
+
+import type { Api } from "../../api";
+import { type NetTransition, readExecutionNet, TokenGame } from "../../model/net";
+import { isConstraint, isNode, objectOf } from "../../core/elements";
+import type PatternImporter from "../../core/PatternImporter";
+
+const OVERLAY = "hrc-game";
+const MARKERS = ["hrc-enabled", "hrc-running", "hrc-fired", "hrc-stuck"];
+
+export interface Replay {
+  labels: string[];
+  elements: string[];
+}
+
+export default class TokenGameMode {
+  static $inject = ["eventBus", "config.api", "patternImporter", "elementRegistry", "canvas", "overlays"];
+
+  game: TokenGame | null = null;
+  replaying: Replay | null = null;
+  showConstraintPlaces = false;
+  private runner: ReturnType<typeof setInterval> | undefined;
+
+  constructor(
+    private readonly eventBus: EventBus,
+    private readonly api: Api,
+    private readonly importer: PatternImporter,
+    private readonly elementRegistry: ElementRegistry,
+    private readonly canvas: Canvas,
+    private readonly overlays: Overlays,
+  ) {
+    eventBus.on("element.click", 3000, (event: { element: Shape }) => {
+      if (!this.game) return;
+      if (isNode(event.element)) this.fireTask(event.element.id);
+      return false;
+    });
+    eventBus.on("element.dblclick", 3000, () => (this.game ? false : undefined));
+    eventBus.on("diagram.clear", () => this.stop());
+  }
+
+  get active(): boolean {
+    return this.game !== null;
+  }
+
+  async start(): Promise<void> {
+    this.stop();
+    const net = readExecutionNet(await this.api.executionNet(this.importer.document()));
+    this.game = new TokenGame(net);
+    this.canvas.getContainer().classList.add("hrc-playing");
+    this.eventBus.fire("tokenGame.started", {});
+    this.render();
+  }
+
+  /** Restarts the game and queues a witness; forward() steps through it. */
+  async replay(labels: string[], elements: string[]): Promise<void> {
+    await this.start();
+    (this.game as TokenGame).load(labels);
+    this.replaying = { labels, elements };
+    this.render();
+  }
+
+  stop(): void {
+    clearInterval(this.runner);
+    if (!this.game) return;
+    this.game = null;
+    this.replaying = null;
+    this.clearMarks();
+    for (const shape of this.elementRegistry.filter(isNode)) {
+      delete (shape as Shape).gameTokens;
+      this.eventBus.fire("element.changed", { element: shape });
+    }
+    this.canvas.getContainer().classList.remove("hrc-playing");
+    this.eventBus.fire("tokenGame.stopped", {});
+  }
+
+  /** What a click on a node does: fire the task's completion, its start, or the silent transition. */
+  fireTask(id: string): NetTransition | null {
+    const game = this.game;
+    const firing = game?.firingFor(id) ?? null;
+    if (!game || !firing) return null;
+    game.fire(firing.id);
+    this.replaying = null;
+    this.render();
+    return firing;
+  }
+
+  back(): void {
+    if (this.game?.back()) this.render();
+  }
+
+  forward(): void {
+    if (this.game?.forward()) this.render();
+  }
+
+  reset(): void {
+    if (!this.game) return;
+    const replay = this.replaying;
+    this.game.reset();
+    if (replay) this.game.load(replay.labels);
+    this.render();
+  }
+
+  /** Fires random enabled transitions, one every `everyMs`, until none is enabled or `steps` were fired. */
+  runRandomly(steps = 50, everyMs = 250): void {
+    clearInterval(this.runner);
+    let left = steps;
+    this.runner = setInterval(() => {
+      const fired = this.game?.fireRandom() ?? null;
+      this.replaying = null;
+      this.render();
+      left -= 1;
+      if (!fired || left <= 0) clearInterval(this.runner);
+    }, everyMs);
+  }
+
+  toggleConstraintPlaces(show: boolean): void {
+    this.showConstraintPlaces = show;
+    this.render();
+  }
+
+  /** The caption for the bar: what just fired, what can fire, or where a witness ends. */
+  caption(): string {
+    const game = this.game;
+    if (!game) return "";
+    const last = game.history[game.history.length - 1];
+    if (this.replaying) {
+      const done = game.history.length;
+      const total = done + game.future.length;
+      if (game.future.length === 0) {
+        return `Witness replayed (${done} of ${total}): ${this.replaying.labels.join(", ") || "from the start"}. Nothing more can happen for ${this.replaying.elements.join(", ")}.`;
+      }
+      return `Witness step ${done} of ${total}${last ? `: ${last.label}` : ""}. Next: ${game.future[0].label}.`;
+    }
+    const enabled = game.enabled();
+    const lastWords = last ? `Fired ${last.label}. ` : "";
+    if (enabled.length === 0) return `${lastWords}Nothing is enabled.`;
+    return `${lastWords}Enabled: ${enabled.map((t) => t.label).join(", ")}.`;
+  }
+
+  private render(): void {
+    const game = this.game;
+    if (!game) return;
+    this.clearMarks();
+    for (const place of game.net.places) {
+      if (place.kind !== "flow") continue;
+      const shape = this.elementRegistry.get(place.of[0] ?? place.id) as Shape | undefined;
+      if (!shape) continue;
+      shape.gameTokens = game.tokens(place.id);
+      this.eventBus.fire("element.changed", { element: shape });
+    }
+    for (const shape of this.elementRegistry.filter((element) => objectOf(element)?.kind === "transition") as Shape[]) {
+      if (game.isRunning(shape.id)) {
+        this.mark(shape.id, "hrc-running");
+        this.badge(shape.id, "running", "hrc-running-badge", { top: -14, left: 4 });
+      }
+      if (game.firingFor(shape.id)) this.mark(shape.id, "hrc-enabled");
+    }
+    const last = game.history[game.history.length - 1];
+    if (last && this.elementRegistry.get(last.task)) this.mark(last.task, "hrc-fired");
+    if (this.replaying && game.future.length === 0) {
+      for (const id of this.replaying.elements) if (this.elementRegistry.get(id)) this.mark(id, "hrc-stuck");
+    }
+    if (this.showConstraintPlaces) this.showConstraintTokens(game);
+    this.eventBus.fire("tokenGame.changed", { caption: this.caption() });
+  }
+
+  private showConstraintTokens(game: TokenGame): void {
+    const constraints = this.elementRegistry.filter(isConstraint) as Connection[];
+    for (const place of game.net.places.filter((p) => p.kind === "constraint")) {
+      const [a, b] = place.of;
+      const connection = constraints.find((c) => (c.source?.id === a && c.target?.id === b) || (c.source?.id === b && c.target?.id === a));
+      if (!connection) continue;
+      const tokens = game.tokens(place.id);
+      this.badge(connection.id, `${place.label}: ${tokens}`, `hrc-constraint-place${tokens ? " hrc-marked" : ""}`, { top: 10, left: 0 });
+    }
+  }
+
+  private mark(id: string, marker: string): void {
+    this.canvas.addMarker(id, marker);
+  }
+
+  private badge(id: string, text: string, className: string, position: { top: number; left: number }): void {
+    const html = document.createElement("div");
+    html.className = className;
+    html.textContent = text;
+    this.overlays.add(id, OVERLAY, { position, html });
+  }
+
+  private clearMarks(): void {
+    this.overlays.remove({ type: OVERLAY });
+    for (const element of this.elementRegistry.getAll()) {
+      if (objectOf(element)?.kind === "root") continue;
+      for (const marker of MARKERS) this.canvas.removeMarker(element.id, marker);
+    }
+  }
+}
+

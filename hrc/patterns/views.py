@@ -1,0 +1,87 @@
+"""The pattern editor's pages: the organisation's patterns, a new pattern, editing one.
+
+Behind the API's organisation wall and roles: a pattern of another
+organisation is a 404 whatever its id; a member who may not write (an
+operator) gets 403 on the editor. The pages only read: the editor script
+(frontend/src/editor/) saves, checks and publishes through the REST API, so
+the services' checks and refusal messages stay in one place.
+"""
+
+from typing import Any
+
+from django.contrib.auth.decorators import login_required
+from django.http import HttpRequest, HttpResponse
+from django.shortcuts import get_object_or_404, render
+from django.views.decorators.csrf import ensure_csrf_cookie
+
+from hrc.organisations.models import Organisation
+from hrc.organisations.selectors import may_write_in, writable_organisations
+from hrc.patterns.selectors import patterns_visible_to
+
+WRITERS_ONLY = "Only engineers and admins of the organisation draw and change its patterns."
+
+
+@login_required
+def pattern_list(request: HttpRequest) -> HttpResponse:
+    """Every pattern of the user's organisations; writers get "new" and "open"."""
+    writable = list(writable_organisations(request.user).order_by("name"))
+    writable_ids = {organisation.pk for organisation in writable}
+    patterns = patterns_visible_to(request.user).order_by("organisation__name", "name", "id")
+    rows = [(pattern, pattern.organisation_id in writable_ids) for pattern in patterns]
+    return render(request, "patterns/list.html", {"rows": rows, "writable": writable})
+
+
+@login_required
+@ensure_csrf_cookie
+def pattern_new(request: HttpRequest) -> HttpResponse:
+    """The editor on an empty model; it is created in `?organisation=` (or the writer's only one) when first saved."""
+    organisation = _target_organisation(request)
+    if organisation is None:
+        return _refused(request, 403, WRITERS_ONLY)
+    config = {
+        "pattern": {
+            "id": None,
+            "name": "New pattern",
+            "canWrite": True,
+            "organisation": organisation.pk,
+        },
+        "draft": None,
+    }
+    return _editor(request, config, f"New pattern in {organisation.name}")
+
+
+@login_required
+@ensure_csrf_cookie
+def pattern_edit(request: HttpRequest, pk: int) -> HttpResponse:
+    """The editor on a pattern's draft."""
+    pattern = get_object_or_404(patterns_visible_to(request.user), pk=pk)
+    if not may_write_in(request.user, pattern.organisation_id):
+        return _refused(request, 403, WRITERS_ONLY)
+    config = {
+        "pattern": {
+            "id": pattern.pk,
+            "name": pattern.name,
+            "canWrite": True,
+            "organisation": pattern.organisation_id,
+            "latestVersion": getattr(pattern, "latest_version", None),
+        },
+        "draft": pattern.draft,
+    }
+    return _editor(request, config, pattern.name)
+
+
+def _target_organisation(request: HttpRequest) -> Organisation | None:
+    """The organisation a new pattern goes to; None when the user may write in none of those asked."""
+    writable = writable_organisations(request.user)
+    requested = request.GET.get("organisation", "")
+    if requested.isdigit():
+        return writable.filter(pk=int(requested)).first()
+    return writable.order_by("name", "pk").first()
+
+
+def _editor(request: HttpRequest, config: dict[str, Any], title: str) -> HttpResponse:
+    return render(request, "patterns/editor.html", {"config": config, "title": title})
+
+
+def _refused(request: HttpRequest, status: int, message: str) -> HttpResponse:
+    return render(request, "patterns/refused.html", {"message": message}, status=status)
