@@ -10,7 +10,7 @@ on the pattern's own elements:
         {"id": "p2", "label": "p2", "tokens": 0, "kind": "flow", "of": "p2"},
         {"id": "running:tc1", "label": "tc1 running", "tokens": 0, "kind": "busy", "of": "tc1"},
         {"id": "time:to1>tc2", "label": "to1 done, for tc2", "tokens": 0, "kind": "constraint",
-         "of": {"constraint": 0, "type": "time", "role": "time", "from": "to1", "to": "tc2"},
+         "of": ["to1", "tc2"], "constraint": {"index": 0, "type": "time", "role": "time"},
          "needs": "a completion of to1 (time constraint to1 → tc2)"}
       ],
       "transitions": [
@@ -26,10 +26,11 @@ on the pattern's own elements:
 
 - a `flow` place is a place of the pattern (`of`: its id); a `busy` place is
   marked while the task `of` runs; a `constraint` place is what a constraint
-  adds (`of`: the constraint's index in the document's `constraints`, its type,
-  its two tasks as written, and `role`: `time`, or `func-start` (the supporter
-  runs) / `func-done` (the supported task has completed); `needs` says what the
-  task that consumes it waits for);
+  adds (`of`: its two tasks, `from` and `to` as the document writes them;
+  `constraint`: its index in the document's `constraints`, its type, and
+  `role`: `time`, or `func-start` (the supporter runs) / `func-done` (the
+  supported task has completed); `needs` says what the task that takes its
+  token waits for);
 - a transition is a task's `start` or `complete`, or a `silent` step of the
   pattern (`task`: the pattern transition it belongs to);
 - a transition fires when each of its input places holds a token, taking one
@@ -109,12 +110,7 @@ def _constraint_place(pattern: Pattern, place: ConstraintPlace) -> Json:
     return {
         "label": label,
         "kind": "constraint",
-        "of": {
-            "constraint": index,
-            "type": constraint.type,
-            "role": place.kind,
-            "from": constraint.source,
-            "to": constraint.target,
-        },
+        "of": [constraint.source, constraint.target],
+        "constraint": {"index": index, "type": constraint.type, "role": place.kind},
         "needs": place.needed(),
     }

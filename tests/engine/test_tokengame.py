@@ -44,13 +44,8 @@ def test_a_time_constraint_is_a_place_from_one_completion_to_the_other_start() -
     net = execution_net_json(read_pattern(example("synch_1o1c_assembly")))
     place = _by_id(net["places"])["time:to1>tc2"]
     assert place["kind"] == "constraint"
-    assert place["of"] == {
-        "constraint": 0,
-        "type": "time",
-        "role": "time",
-        "from": "to1",
-        "to": "tc2",
-    }
+    assert place["of"] == ["to1", "tc2"]
+    assert place["constraint"] == {"index": 0, "type": "time", "role": "time"}
     assert "to1" in place["needs"]
     arcs = {tuple(arc) for arc in net["arcs"]}
     assert {("complete:to1", "time:to1>tc2"), ("time:to1>tc2", "start:tc2")} <= arcs
@@ -63,9 +58,11 @@ def test_a_func_constraint_is_two_places_named_by_their_role() -> None:
         p for p in execution_net_json(read_pattern(data))["places"] if p["kind"] == "constraint"
     ]
     # The cobot's task supports the operator's.
-    assert [(p["id"], p["of"]["role"], p["of"]["constraint"]) for p in places] == [
-        ("func-start:tc2>to1", "func-start", 0),
-        ("func-done:to1>tc2", "func-done", 0),
+    assert [
+        (p["id"], p["constraint"]["role"], p["constraint"]["index"], p["of"]) for p in places
+    ] == [
+        ("func-start:tc2>to1", "func-start", 0, ["to1", "tc2"]),
+        ("func-done:to1>tc2", "func-done", 0, ["to1", "tc2"]),
     ]
 
 

@@ -167,9 +167,16 @@ class NetPlaceSerializer(_Labelled):
     )
     of = serializers.JSONField(
         help_text=(
-            "flow: the place's id; busy: the task's id; constraint: {constraint: index in the "
-            "document's constraints, type, role: time | func-start | func-done, from, to}."
+            "The pattern's elements it stands for: flow, the place's id; busy, the task's id; "
+            "constraint, [from, to] as the constraint is written."
         )
+    )
+    constraint = serializers.JSONField(
+        required=False,
+        help_text=(
+            "Constraint places: {index: in the document's constraints, type, "
+            "role: time | func-start | func-done}."
+        ),
     )
     needs = serializers.CharField(
         required=False, help_text="Constraint places: what the task that takes the token waits for."
