@@ -22,6 +22,7 @@ from typing import Any
 from asgiref.sync import sync_to_async
 from asyncua import Client, Node, ua
 from django.conf import settings
+from django.db import connections
 
 from hrc.cobots import urua
 from hrc.cobots.models import Cobot
@@ -130,10 +131,13 @@ class Monitor:
         cobots = Cobot.objects.filter(is_active=True)
         if self.organisation is not None:
             cobots = cobots.filter(organisation_id=self.organisation)
-        return [
-            Watched(c.pk, c.name, c.endpoint, c.credentials_source, c.organisation_id, c.cell)
-            for c in cobots
-        ]
+        try:
+            return [
+                Watched(c.pk, c.name, c.endpoint, c.credentials_source, c.organisation_id, c.cell)
+                for c in cobots
+            ]
+        finally:
+            connections.close_all()  # one read every RELOAD_SECONDS: no connection held between
 
     async def _watch_forever(self, watched: Watched) -> None:
         delay = BACKOFF[0]

@@ -29,6 +29,7 @@ from playwright.sync_api import (
 )
 
 from tests import factories
+from tests.cases.conftest import broker, start_worker  # noqa: F401  # the tablet tests' worker
 
 CHROMIUM = "/usr/bin/chromium"
 SCREENSHOTS = Path(settings.BASE_DIR) / "var" / "screenshots"

@@ -57,3 +57,24 @@ async def db(function: Any, *args: Any, **kwargs: Any) -> Any:
             connections.close_all()
 
     return await asyncio.to_thread(run)
+
+
+def run(coroutine: Any) -> Any:
+    """asyncio.run in a thread of its own: Playwright's sync API may hold this thread's loop
+    (browser tests in the same process)."""
+    import threading
+
+    outcome: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            outcome["value"] = asyncio.run(coroutine)
+        except BaseException as error:  # re-raised in the test's thread
+            outcome["error"] = error
+
+    thread = threading.Thread(target=target, name="live-test-scenario")
+    thread.start()
+    thread.join()
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome.get("value")

@@ -24,7 +24,7 @@ from hrc.live.models import CellStop
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cobots.simulator import PROGRAM
-from tests.live.client import db, open_socket, receive, receive_until
+from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.server import LiveServer, MonitorProcess, session_cookie
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -98,7 +98,7 @@ def test_the_panel_follows_the_gateway_at_most_ten_times_a_second(
         assert busiest <= round(1 / STATE_INTERVAL) + 1
         assert len(frames) >= 10  # and it was not silent
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def _move_back_and_forth(driver: SyncDriver) -> None:
@@ -121,7 +121,7 @@ def test_a_tablet_of_another_cell_gets_no_state_of_this_one(
         with pytest.raises(TimeoutError):
             await receive(elsewhere, timeout=1.0)
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_stop_pauses_the_cell_and_only_a_confirmed_resume_restarts_it(
@@ -163,7 +163,7 @@ def test_stop_pauses_the_cell_and_only_a_confirmed_resume_restarts_it(
         )
         assert ended["stop"]["resumed_by"] == operator.username
 
-    asyncio.run(scenario())
+    run(scenario())
     cobot.refresh_from_db()
     assert cobot.stopped_at is None
     assert CellStop.objects.get().resumed_at is not None

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
-
 import pytest
 from django.contrib.auth.models import User
 from websockets.exceptions import ConnectionClosed, InvalidStatus
@@ -12,8 +10,7 @@ from hrc.cases import services as case_services
 from hrc.cases.models import Case, WorkItem
 from hrc.live import broadcast
 from hrc.organisations.models import Organisation
-from tests import factories
-from tests.live.client import db, open_socket, receive, receive_until
+from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.server import LiveServer, session_cookie
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -30,7 +27,7 @@ def test_a_socket_without_a_session_is_refused(server: LiveServer) -> None:
         assert closed.value.rcvd is not None
         assert closed.value.rcvd.code == 4401
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_a_page_of_another_site_cannot_open_the_socket(server: LiveServer, operator: User) -> None:
@@ -41,7 +38,7 @@ def test_a_page_of_another_site_cannot_open_the_socket(server: LiveServer, opera
             await open_socket(server, cookie, origin="http://evil.example")
         assert refused.value.response.status_code == 403
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_an_outsider_naming_our_organisation_is_refused(
@@ -61,7 +58,7 @@ def test_an_outsider_naming_our_organisation_is_refused(
         assert closed.value.rcvd is not None
         assert closed.value.rcvd.code == 4403
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_a_bad_cell_name_is_refused_with_a_reason(server: LiveServer, operator: User) -> None:
@@ -73,7 +70,7 @@ def test_a_bad_cell_name_is_refused_with_a_reason(server: LiveServer, operator: 
         assert refused["type"] == "refused"
         assert "'a b' is not a cell name" in refused["reason"]
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_the_operator_gets_a_snapshot_then_numbered_deltas(
@@ -106,7 +103,7 @@ def test_the_operator_gets_a_snapshot_then_numbered_deltas(
         assert delta["item"]["claimed_by"] == operator.pk
         await socket.close()
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_an_outsider_connected_to_their_own_organisation_sees_nothing_of_ours(
@@ -131,7 +128,7 @@ def test_an_outsider_connected_to_their_own_organisation_sees_nothing_of_ours(
         with pytest.raises(TimeoutError):
             await receive(outsider_socket, timeout=1.0)
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_a_resync_request_gets_a_fresh_snapshot(
@@ -142,10 +139,10 @@ def test_a_resync_request_gets_a_fresh_snapshot(
     async def scenario() -> None:
         socket = await open_socket(server, cookie)
         first = await receive(socket)
-        await db(factories.make_case, choice_case.version, started_by=None,
+        await db(case_services.start_case, choice_case.version, started_by=None,
                  actor_mapping={"o": {"users": [operator.pk]}})  # fmt: skip
         await socket.send('{"type": "resync"}')
         fresh = await receive_until(socket, lambda e: e["type"] == "snapshot")
         assert len(fresh["cases"]) == len(first["cases"]) + 1
 
-    asyncio.run(scenario())
+    run(scenario())

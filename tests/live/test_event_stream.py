@@ -4,7 +4,6 @@ exactly the snapshot a tablet that connects afterwards gets."""
 
 from __future__ import annotations
 
-import asyncio
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -18,7 +17,7 @@ from hrc.cases.models import Case, Job, WorkItem
 from hrc.cases.simulation import Simulation
 from hrc.live import broadcast
 from tests.cases.patterns import cobot_chain
-from tests.live.client import db, open_socket, receive, receive_until
+from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.replay import replay
 from tests.live.server import LiveServer, session_cookie
 
@@ -100,7 +99,7 @@ def test_deltas_applied_to_an_old_snapshot_give_the_fresh_snapshot(
         assert replayed["holes"] is False
         assert _comparable({"type": "", **replayed["state"]}) == _comparable(fresh)
 
-    asyncio.run(scenario())
+    run(scenario())
 
 
 def test_a_missed_delta_is_found_by_its_number(server: LiveServer, simulation: Simulation) -> None:
@@ -126,4 +125,4 @@ def test_a_missed_delta_is_found_by_its_number(server: LiveServer, simulation: S
         assert lost_one["holes"] is True
         assert lost_one["outcomes"] == ["applied", "applied", "held"]
 
-    asyncio.run(scenario())
+    run(scenario())

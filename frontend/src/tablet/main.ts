@@ -122,7 +122,7 @@ function cobotPanel(cobot: CobotData): HTMLElement {
   const rows: Array<[string, string]> = [
     ["Mode", state ? state.robot_mode : "unknown"],
     ["Safety", state ? humanSafety(state.safety_mode) : "unknown"],
-    ["Program", state ? `${state.program || "none"} · ${state.program_state}` : "unknown"],
+    ["Program", state ? `${programName(state.program) || "none"} · ${state.program_state}` : "unknown"],
     ["Step", cobot.queue.current ? `${cobot.queue.current.step ?? "device call"} · case ${cobot.queue.current.case}` : "none"],
     ["Queue", String(cobot.queue.queue_length)],
   ];
@@ -142,6 +142,11 @@ function cobotPanel(cobot: CobotData): HTMLElement {
     panel.append(joints);
   }
   return panel;
+}
+
+/** "pick" for "/programs/pick.urp": the name people gave it. */
+function programName(path: string): string {
+  return path.replace(/\\/g, "/").split("/").pop()!.replace(/\.urp$/i, "");
 }
 
 function renderStop(state: LiveState): void {
@@ -226,6 +231,7 @@ async function openForm(id: number): Promise<void> {
   }
   const form = element("form", "task-form");
   form.method = "dialog";
+  form.noValidate = true; // the server checks the form and names each field it refuses
   const fields = element("div", "fields");
   const read = renderForm(fields, detail.form);
   const error = element("p", "errors");
