@@ -66,6 +66,7 @@ bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC 
 	$(PY) -m bench.run
 	$(PY) -m bench.handshake
 	$(PY) -m bench.runtime
+	$(PY) -m bench.live
 
 lock:  ## re-resolve requirements/*.in into the lock files
 	python3 -m venv /tmp/hrc-lock && /tmp/hrc-lock/bin/pip -q install uv

@@ -280,11 +280,12 @@ class _Sender:
 
     def _send_batch(self, batch: list[_Work], loop: asyncio.AbstractEventLoop) -> None:
         sends = [work for work in batch if isinstance(work, _Send)]
-        changed = list(dict.fromkeys(w.cobot_id for w in batch if isinstance(w, _QueueChanged)))
-        if changed:
-            sends += _queue_messages(changed)
         if sends:
             _run_on_layer(_group_send_all(sends), loop)
+        # The queues after the case deltas: reading them must not delay the new task.
+        changed = list(dict.fromkeys(w.cobot_id for w in batch if isinstance(w, _QueueChanged)))
+        if changed:
+            _run_on_layer(_group_send_all(_queue_messages(changed)), loop)
 
 
 def _queue_messages(cobot_ids: list[int]) -> list[_Send]:

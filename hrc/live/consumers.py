@@ -5,9 +5,12 @@ On connect: refused (a `refused` event, then close 4401/4403) unless the
 session's user is a member of the organisation; then the socket joins its
 groups and only then reads the snapshot (hrc.live.events explains why). Each
 event type has its handler; every send first re-checks that the event is the
-organisation's and the cell's, and that the user is still a member (read
-again when the last check is older than RECHECK_SECONDS). `cobot-state`
-deltas are coalesced: at most one frame per STATE_INTERVAL per socket.
+organisation's and the cell's, and that the user's membership still holds.
+Memberships are read again every RECHECK_SECONDS for all the process's
+sockets in one query (Memberships), not per socket and send: 200 tablets
+would otherwise queue 200 reads in front of one delta. A socket whose
+membership is gone is refused and closed. `cobot-state` deltas are
+coalesced: at most one frame per STATE_INTERVAL per socket.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from hrc.live import broadcast, selectors
 from hrc.live.events import CobotStateData, LiveEvent
 from hrc.live.selectors import Access
 
-# Seconds a membership check stays good before the next send reads it again.
+# Seconds between two reads of the connected sockets' memberships.
 RECHECK_SECONDS = 5.0
 # At most 10 cobot-state frames a second per tablet.
 STATE_INTERVAL = 0.1
@@ -58,8 +61,8 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
         if self.access is None:
             await self._refuse("You are not a member of this organisation.", FORBIDDEN)
             return
-        self._checked_at = time.monotonic()
         access = self.access
+        MEMBERSHIPS.watch(self)
         self.groups_joined = [
             broadcast.organisation_group(access.organisation_id),
             broadcast.user_group(access.user_id),
@@ -70,6 +73,7 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
         await self._send_snapshot()
 
     async def disconnect(self, code: int) -> None:
+        MEMBERSHIPS.forget(self)
         if self._state_flush is not None:
             self._state_flush.cancel()
         for group in self.groups_joined:
@@ -128,7 +132,7 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
     async def _flush_states(self) -> None:
         self._state_flush = None
         states, self._states = list(self._states.values()), {}
-        if states and self.access is not None and await self._still_member():
+        if states and self.access is not None:
             self._last_state_frame = time.monotonic()
             await self.send_json({"type": "cobot-state", "states": states})
 
@@ -138,30 +142,57 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
         if access is None or message.get("organisation") != access.organisation_id:
             return False
         cell = message.get("cell", "")
-        if self.cell and cell != self.cell and message["event"].get("type") != "cell-stop":
-            return False
-        return await self._still_member()
+        return not self.cell or cell == self.cell or message["event"].get("type") == "cell-stop"
 
-    async def _still_member(self) -> bool:
-        assert self.access is not None
-        if time.monotonic() - self._checked_at < RECHECK_SECONDS:
-            return True
-        if await database_sync_to_async(selectors.still_member)(self.access):
-            self._checked_at = time.monotonic()
-            return True
-        await self._refuse("You are no longer a member of this organisation.", FORBIDDEN)
-        return False
+    async def revoke(self) -> None:
+        """The membership is gone (Memberships found it): nothing more is sent."""
+        if self.access is not None:
+            await self._refuse("You are no longer a member of this organisation.", FORBIDDEN)
 
     async def _send_snapshot(self) -> None:
         assert self.access is not None
         snapshot = await database_sync_to_async(selectors.snapshot)(self.access, self.cell)
-        self._checked_at = time.monotonic()
         await self.send_json(snapshot)
 
     async def _refuse(self, reason: str, code: int) -> None:
         self.access = None
         await self.send_json({"type": "refused", "reason": reason})
         await self.close(code=code)
+
+
+class Memberships:
+    """The process's sockets and their memberships, read again every RECHECK_SECONDS in one query."""
+
+    def __init__(self) -> None:
+        self.sockets: set[TabletConsumer] = set()
+        self.task: asyncio.Task[None] | None = None
+
+    def watch(self, socket: TabletConsumer) -> None:
+        self.sockets.add(socket)
+        if self.task is None or self.task.done():
+            self.task = asyncio.get_running_loop().create_task(self._recheck_forever())
+
+    def forget(self, socket: TabletConsumer) -> None:
+        self.sockets.discard(socket)
+
+    async def _recheck_forever(self) -> None:
+        while self.sockets:
+            await asyncio.sleep(RECHECK_SECONDS)
+            await self.recheck()
+
+    async def recheck(self) -> None:
+        watched = [s for s in self.sockets if s.access is not None]
+        if not watched:
+            return
+        pairs = {(s.access.user_id, s.access.organisation_id) for s in watched}  # type: ignore[union-attr]
+        valid = await database_sync_to_async(selectors.valid_memberships)(pairs)
+        for socket in watched:
+            access = socket.access
+            if access is not None and (access.user_id, access.organisation_id) not in valid:
+                await socket.revoke()
+
+
+MEMBERSHIPS = Memberships()
 
 
 def _parameters(query_string: bytes) -> tuple[int | None, str]:

@@ -59,10 +59,16 @@ def access_of(user: AnyUser, organisation_id: int | None) -> Access | None:
     return Access(user.pk, user.get_username(), found[0], found[1])
 
 
-def still_member(access: Access) -> bool:
-    return Membership.objects.filter(
-        user_id=access.user_id, organisation_id=access.organisation_id, user__is_active=True
-    ).exists()
+def valid_memberships(pairs: set[tuple[int, int]]) -> set[tuple[int, int]]:
+    """Those of the (user, organisation) pairs that are still memberships of an active user."""
+    if not pairs:
+        return set()
+    users = {user for user, _ in pairs}
+    organisations = {organisation for _, organisation in pairs}
+    found = Membership.objects.filter(
+        user_id__in=users, organisation_id__in=organisations, user__is_active=True
+    ).values_list("user_id", "organisation_id")
+    return set(found) & pairs
 
 
 def snapshot(access: Access, cell: str) -> Snapshot:

@@ -9,7 +9,8 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from hrc.cases import services as case_services
 from hrc.cases.models import Case, WorkItem
 from hrc.live import broadcast
-from hrc.organisations.models import Organisation
+from hrc.live.consumers import RECHECK_SECONDS
+from hrc.organisations.models import Membership, Organisation
 from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.server import LiveServer, session_cookie
 
@@ -144,5 +145,25 @@ def test_a_resync_request_gets_a_fresh_snapshot(
         await socket.send('{"type": "resync"}')
         fresh = await receive_until(socket, lambda e: e["type"] == "snapshot")
         assert len(fresh["cases"]) == len(first["cases"]) + 1
+
+    run(scenario())
+
+
+def test_a_member_who_leaves_the_organisation_is_cut_off(
+    server: LiveServer, operator: User, organisation: Organisation, choice_case: Case
+) -> None:
+    cookie = session_cookie(operator)
+
+    async def scenario() -> None:
+        socket = await open_socket(server, cookie)
+        assert (await receive(socket))["type"] == "snapshot"
+        await db(Membership.objects.filter(user=operator, organisation=organisation).delete)
+        # Within one round of the server's membership check (every RECHECK_SECONDS).
+        refused = await receive_until(
+            socket, lambda e: e["type"] == "refused", timeout=RECHECK_SECONDS + 5
+        )
+        assert "no longer a member" in refused["reason"]
+        with pytest.raises(ConnectionClosed):
+            await receive(socket, timeout=5)
 
     run(scenario())
