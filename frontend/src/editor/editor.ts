@@ -16,9 +16,12 @@ import MoveCanvasModule from "diagram-js/lib/navigation/movecanvas";
 import ZoomScrollModule from "diagram-js/lib/navigation/zoomscroll";
 import KeyboardMoveModule from "diagram-js/lib/navigation/keyboard-move";
 import type Canvas from "diagram-js/lib/core/Canvas";
+import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
+import type { Shape } from "diagram-js/lib/model/Types";
 
 import type { Api } from "./api";
 import CoreModule from "./core";
+import { isLane, isNode } from "./core/elements";
 import type PatternImporter from "./core/PatternImporter";
 import CheckingModule from "./features/checking";
 import ConstraintsModule from "./features/constraints";
@@ -84,7 +87,8 @@ export class PatternEditor {
 
   constructor(readonly options: EditorOptions) {
     this.diagram = new Diagram({
-      canvas: { container: options.canvas },
+      // autoFocus: keys reach the canvas again after a click on the palette or the context pad.
+      canvas: { container: options.canvas, autoFocus: true },
       keyboard: { bind: true },
       modules: MODULES,
       shell: { toolbar: options.toolbar, side: options.side },
@@ -92,6 +96,7 @@ export class PatternEditor {
       pattern: options.pattern,
       liveChecking: options.liveChecking ?? true,
     } as never);
+    this.get<{ on(event: string, callback: () => void): void }>("eventBus").on("editor.fit", () => this.fit());
   }
 
   get<T>(name: string): T {
@@ -110,11 +115,11 @@ export class PatternEditor {
   fit(): void {
     const canvas = this.get<Canvas>("canvas");
     const size = canvas.getSize();
-    const root = canvas.getRootElement() as { businessObject?: { width?: number; height?: number } };
-    const width = Math.max(root.businessObject?.width ?? 1000, 200);
-    const height = Math.max(root.businessObject?.height ?? 400, 200);
+    const shapes = this.get<ElementRegistry>("elementRegistry").filter((element) => isNode(element) || isLane(element)) as Shape[];
+    const right = Math.max(1000, ...shapes.map((shape) => shape.x + shape.width));
+    const bottom = Math.max(360, ...shapes.map((shape) => shape.y + shape.height + 20));
     const left = 80;
-    const scale = Math.min(1.4, (size.width - left - 20) / width, (size.height - 40) / height);
+    const scale = Math.min(1.4, (size.width - left - 20) / right, (size.height - 40) / bottom);
     canvas.viewbox({ x: -left / scale, y: -20 / scale, width: size.width / scale, height: size.height / scale });
   }
 

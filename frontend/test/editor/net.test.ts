@@ -11,12 +11,12 @@ function handOver(constraint: "to1>tc1" | "tc1>to1" = "to1>tc1"): ExecutionNet {
   return readExecutionNet({
     places: [
       { id: "p0", label: "p0", tokens: 1, kind: "flow", of: "p0" },
-      { id: "p1", label: "p1", tokens: 0, kind: "flow", of: "p1" },
+      { id: "p1", label: "p1", tokens: null, kind: "flow", of: "p1" },
       { id: "p2", label: "p2", tokens: 0, kind: "flow", of: "p2" },
       { id: "p3", label: "p3", tokens: 0, kind: "flow", of: "p3" },
       { id: "running:to1", label: "to1 running", tokens: 0, kind: "busy", of: "to1" },
       { id: "running:tc1", label: "tc1 running", tokens: 0, kind: "busy", of: "tc1" },
-      { id: `time:${a}>${b}`, label: `time ${a} → ${b}`, tokens: 0, kind: "constraint", of: [a, b] },
+      { id: `time:${a}>${b}`, label: `${a} done, for ${b}`, tokens: null, kind: "constraint", of: { constraint: 0, type: "time", role: "time", from: a, to: b } },
     ],
     transitions: [
       { id: "t1", label: "t1", kind: "silent", task: "t1" },
@@ -31,6 +31,9 @@ function handOver(constraint: "to1>tc1" | "tc1>to1" = "to1>tc1"): ExecutionNet {
       ["p2", "start:tc1"], ["start:tc1", "running:tc1"], ["running:tc1", "complete:tc1"], ["complete:tc1", "p3"],
       [`complete:${a}`, `time:${a}>${b}`], [`time:${a}>${b}`, `start:${b}`],
     ],
+    initial: { p0: 1 },
+    final: { p3: 1 },
+    ignored: [`time:${a}>${b}`],
   });
 }
 
@@ -39,6 +42,7 @@ const labels = (game: TokenGame) => game.enabled().map((t) => t.label);
 describe("the token game", () => {
   test("fires the initial marking's enabled transitions only", () => {
     const game = new TokenGame(handOver());
+    expect(game.net.places.find((place) => place.kind === "constraint")?.of).toEqual(["to1", "tc1"]);
     expect(labels(game)).toEqual(["t1"]);
     expect(() => game.fire("start:to1")).toThrowError("start to1 is not enabled.");
   });

@@ -38,10 +38,11 @@ export function readExecutionNet(value: unknown): ExecutionNet {
   if (!isObject(value) || !Array.isArray(value.places) || !Array.isArray(value.transitions)) {
     throw new Error("The server's execution net has no places or transitions.");
   }
+  const initial = isObject(value.initial) ? value.initial : null;
   const places = value.places.filter(isObject).map((place): NetPlace => {
     const id = String(place.id);
     const kind = (["flow", "busy", "constraint"].includes(String(place.kind)) ? place.kind : guessKind(id)) as PlaceKind;
-    const tokens = Number(place.tokens ?? place.initial ?? 0);
+    const tokens = Number((initial ? initial[id] : undefined) ?? place.tokens ?? place.initial ?? 0);
     return { id, label: String(place.label ?? id), tokens: Number.isFinite(tokens) ? tokens : 0, kind, of: ofList(place.of, id, kind) };
   });
   const transitions = value.transitions.filter(isObject).map((transition): NetTransition => {
@@ -71,6 +72,8 @@ function guessKind(id: string): PlaceKind {
 
 function ofList(of: unknown, id: string, kind: PlaceKind): string[] {
   if (Array.isArray(of)) return of.map(String);
+  // A constraint place names its constraint: {constraint, type, role, from, to}.
+  if (isObject(of) && typeof of.from === "string" && typeof of.to === "string") return [of.from, of.to];
   if (typeof of === "string" && of) return [of];
   if (kind === "busy") return [id.slice("running:".length)];
   if (kind === "constraint") return id.slice(id.indexOf(":") + 1).split(">");

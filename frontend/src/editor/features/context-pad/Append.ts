@@ -14,12 +14,13 @@ import { centre, isNode, laneAt, nodeObject, type NodeObject } from "../../core/
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import { newTaskRefusal } from "../../model/rules";
 import type LaneBehavior from "../lanes/LaneBehavior";
+import type LabelEditing from "../label-editing/LabelEditing";
 import type Refusals from "../rules/Refusals";
 
 export type AppendKind = "place" | "task" | "silent";
 
 export default class Append {
-  static $inject = ["eventBus", "autoPlace", "elementFactory", "laneBehavior", "refusals"];
+  static $inject = ["eventBus", "autoPlace", "elementFactory", "laneBehavior", "refusals", "labelEditing"];
 
   constructor(
     eventBus: EventBus,
@@ -27,6 +28,7 @@ export default class Append {
     private readonly elementFactory: PatternElementFactory,
     private readonly laneBehavior: LaneBehavior,
     private readonly refusals: Refusals,
+    private readonly labelEditing: LabelEditing,
   ) {
     // Right of the source; further down when that spot is taken (a split's second branch).
     eventBus.on("autoPlace", 1500, (event: { source: Shape; shape: Shape }) => {
@@ -41,7 +43,7 @@ export default class Append {
     return nodeObject(source).kind === "place" ? "task" : "place";
   }
 
-  /** Appends and returns the new node, or null (with the reason shown) when it cannot be. */
+  /** Appends and returns the new node (selected; a task opens its label), or null with the reason shown. */
   append(source: Shape, kind: AppendKind = this.defaultKind(source)): Shape | null {
     if (!isNode(source)) return null;
     const from = nodeObject(source).kind;
@@ -62,6 +64,8 @@ export default class Append {
         ? { kind: "place", process: "", data: { id: "" } }
         : { kind: "transition", process: "", silent: kind === "silent", data: { id: "" } };
     const shape = this.elementFactory.createShape({ businessObject: template });
-    return this.autoPlace.append(source, shape, { connection: { businessObject: { kind: "arc" } } }) as Shape;
+    const appended = this.autoPlace.append(source, shape, { connection: { businessObject: { kind: "arc" } } }) as Shape;
+    if (kind === "task") this.labelEditing.activate(appended);
+    return appended;
   }
 }

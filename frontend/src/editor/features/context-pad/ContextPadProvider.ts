@@ -6,6 +6,7 @@
 import type ContextPad from "diagram-js/lib/features/context-pad/ContextPad";
 import type Connect from "diagram-js/lib/features/connect/Connect";
 import type Rules from "diagram-js/lib/features/rules/Rules";
+import type Canvas from "diagram-js/lib/core/Canvas";
 import type { Element, Shape } from "diagram-js/lib/model/Types";
 
 import { CONSTRAINT_TYPES } from "../../model/document";
@@ -21,7 +22,7 @@ type Action = (event: MouseEvent, element: Element) => void;
 type Entry = { group: string; title: string; html: string; action: Record<string, Action> };
 
 export default class ContextPadProvider {
-  static $inject = ["contextPad", "connect", "connectMode", "modeling", "rules", "append", "labelEditing"];
+  static $inject = ["contextPad", "connect", "connectMode", "modeling", "rules", "append", "labelEditing", "canvas"];
 
   constructor(
     contextPad: ContextPad,
@@ -31,6 +32,7 @@ export default class ContextPadProvider {
     private readonly rules: Rules,
     private readonly append: Append,
     private readonly labelEditing: LabelEditing,
+    private readonly canvas: Canvas,
   ) {
     contextPad.registerProvider(this as never);
   }
@@ -65,7 +67,13 @@ export default class ContextPadProvider {
   }
 
   private entry(group: string, title: string, icon: string, run: () => void): Entry {
-    return { group, title, html: entryHtml(icon), action: { click: () => run() } };
+    const click = () => {
+      run();
+      // The pad is outside the canvas and is redrawn for the new selection: give the keys
+      // back to the canvas once that is done, unless a field (a new task's label) took them.
+      setTimeout(() => this.canvas.restoreFocus());
+    };
+    return { group, title, html: entryHtml(icon), action: { click } };
   }
 
   private appendEntry(title: string, icon: string, source: Shape, kind: AppendKind): Entry {

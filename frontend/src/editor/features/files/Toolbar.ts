@@ -2,6 +2,7 @@
 
 import type CommandStack from "diagram-js/lib/command/CommandStack";
 import type EventBus from "diagram-js/lib/core/EventBus";
+import type Canvas from "diagram-js/lib/core/Canvas";
 
 import type AutoLayout from "../layout/AutoLayout";
 import type TokenGameMode from "../token-game/TokenGameMode";
@@ -9,7 +10,7 @@ import type PatternFiles from "./PatternFiles";
 import type { ExportFormat, FilesMessage } from "./PatternFiles";
 
 export default class Toolbar {
-  static $inject = ["eventBus", "config.shell", "patternFiles", "commandStack", "autoLayout", "tokenGame", "config.pattern"];
+  static $inject = ["eventBus", "config.shell", "patternFiles", "commandStack", "autoLayout", "tokenGame", "config.pattern", "canvas"];
 
   constructor(
     eventBus: EventBus,
@@ -19,6 +20,7 @@ export default class Toolbar {
     autoLayout: AutoLayout,
     tokenGame: TokenGameMode,
     pattern: { canWrite: boolean },
+    canvas: Canvas,
   ) {
     const bar = shell.toolbar;
     const name = document.createElement("input");
@@ -30,6 +32,10 @@ export default class Toolbar {
       } catch (error) {
         show({ text: (error as Error).message, kind: "error" });
       }
+    });
+    // Enter keeps the name and goes back to drawing.
+    name.addEventListener("keydown", (event) => {
+      if (event.key === "Enter") canvas.focus();
     });
     bar.appendChild(name);
     const button = (text: string, title: string, run: () => unknown) => {
@@ -46,6 +52,7 @@ export default class Toolbar {
     const save = button("Save", "Save the draft", () => files.save());
     const publish = button("Publish", "Publish the draft as a new version", () => files.publish());
     publish.classList.add("primary");
+    button("Show all", "Fit the whole drawing into view", () => eventBus.fire("editor.fit", {}));
     button("Layout", "Lay the model out in its actor lanes", () => autoLayout.layout().catch((error: Error) => show({ text: `Layout failed: ${error.message}`, kind: "error" })));
     button("Token game", "Play the model: fire tasks by click", () => tokenGame.start().catch((error: Error) => show({ text: `The token game could not start: ${error.message}`, kind: "error" })));
 

@@ -14,7 +14,7 @@ import type GlobalConnect from "diagram-js/lib/features/global-connect/GlobalCon
 import type { Shape } from "diagram-js/lib/model/Types";
 import { hasModifier, isCmd, isKey } from "diagram-js/lib/features/keyboard/KeyboardUtil";
 
-import { isLane, isNode, isTask, objectOf } from "../../core/elements";
+import { isLane, isNode, objectOf } from "../../core/elements";
 import type Append from "../context-pad/Append";
 import type LabelEditing from "../label-editing/LabelEditing";
 
@@ -65,10 +65,6 @@ export default class PatternKeyboard {
 
   private appendNext(): void {
     const source = this.single();
-    if (!source || !isNode(source)) return;
-    const shape = this.append.append(source);
-    if (!shape) return;
-    this.selection.select(shape);
-    if (isTask(shape)) this.labelEditing.activate(shape);
+    if (source && isNode(source)) this.append.append(source);
   }
 }

@@ -31,21 +31,34 @@ export default class LaneBehavior extends CommandInterceptor {
     private readonly elementFactory: PatternElementFactory,
   ) {
     super(eventBus);
-    this.preExecute("shape.create", (context: CommandContext) => this.placeNew(context.shape, context.position));
-    this.postExecute("elements.move", (context: CommandContext) => this.follow(context.shapes as Shape[]));
-    this.postExecute(["shape.create", "elements.move", "elements.create"], () => this.fitWidth());
-    this.preExecute("shape.resize", (context: CommandContext) => {
-      const shape = context.shape as Shape;
-      // A person drags only a lane's height; layout and width-fitting pass hints.free.
-      if (isLane(shape) && !context.hints?.free) context.newBounds = { x: shape.x, y: shape.y, width: shape.width, height: Math.max(80, context.newBounds.height) };
-    });
-    this.postExecute("element.updateData", (context: CommandContext) => {
-      const process = context.object?.process;
-      if (isLane(context.element) && process !== undefined) this.moveNet(context.element, process);
-    });
-    this.postExecute("shape.resize", (context: CommandContext) => {
-      if (!context.hints?.free) this.pushBelow(context.shape, context.oldBounds);
-    });
+    // `true`: the handlers get the command's context, not the event around it.
+    this.preExecute("shape.create", (context: CommandContext) => this.placeNew(context.shape, context.position), true);
+    this.postExecute("elements.move", (context: CommandContext) => this.follow(context.shapes as Shape[]), true);
+    this.postExecute(["shape.create", "elements.move", "elements.create"], () => this.fitWidth(), true);
+    this.preExecute(
+      "shape.resize",
+      (context: CommandContext) => {
+        const shape = context.shape as Shape;
+        // A person drags only a lane's height; layout and width-fitting pass hints.free.
+        if (isLane(shape) && !context.hints?.free) context.newBounds = { x: shape.x, y: shape.y, width: shape.width, height: Math.max(80, context.newBounds.height) };
+      },
+      true,
+    );
+    this.postExecute(
+      "element.updateData",
+      (context: CommandContext) => {
+        const process = context.object?.process;
+        if (isLane(context.element) && process !== undefined) this.moveNet(context.element, process);
+      },
+      true,
+    );
+    this.postExecute(
+      "shape.resize",
+      (context: CommandContext) => {
+        if (!context.hints?.free) this.pushBelow(context.shape, context.oldBounds);
+      },
+      true,
+    );
   }
 
   lanes(): Shape[] {

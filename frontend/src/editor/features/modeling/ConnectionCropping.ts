@@ -22,9 +22,9 @@ export default class ConnectionCropping extends CommandInterceptor {
       const connection = context.connection as Connection;
       connection.waypoints = connectionDocking.getCroppedWaypoints(connection);
       context.cropped = true;
-    });
+    }, true);
     this.reverted(["connection.layout"], (context: CommandContext) => {
       delete context.cropped;
-    });
+    }, true);
   }
 }

@@ -1,0 +1,522 @@
+"""The pattern editor in a real browser (issue 6).
+
+An engineer draws the thesis' Assembly pattern from an empty model with the
+mouse and the keyboard, watches the server's check classify it, adds a time
+constraint that contradicts the flow, sees the deadlock and replays its
+witness, undoes it and publishes. The eight thesis examples open as the
+thesis draws them and are saved as screenshots. Bad imports change nothing
+and say what is wrong; outsiders and operators are kept out.
+"""
+
+import json
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from django.contrib.auth.models import User
+from playwright.sync_api import FilePayload, FloatRect, Page, expect
+
+from hrc.organisations.models import Organisation
+from hrc.patterns.models import PatternModel, PatternVersion
+from tests import factories
+
+pytestmark = pytest.mark.django_db(transaction=True)
+
+SignIn = Callable[[Page, User], None]
+Screenshot = Callable[[Page, str], Path]
+EXAMPLES = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples"
+# The server checks a moment after the model stops changing (LiveChecker, 600 ms).
+CHECKED = 15_000
+RUNNING = re.compile(r"\bhrc-running\b")
+STUCK = re.compile(r"\bhrc-stuck\b")
+
+
+def _open(page: Page, url: str) -> None:
+    page.goto(url)
+    expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
+
+
+def _badge(page: Page) -> Any:
+    return page.get_by_label("Pattern class")
+
+
+@pytest.mark.parametrize("example", sorted(path.stem for path in EXAMPLES.glob("*.json")))
+def test_each_thesis_example_opens_in_its_lanes(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+    example: str,
+) -> None:
+    document = json.loads((EXAMPLES / f"{example}.json").read_text())
+    pattern = factories.make_pattern(organisation, draft=document, name=document["name"])
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+
+    declared = document["declared_pattern"].capitalize()
+    expect(_badge(page)).to_have_text(declared, timeout=CHECKED)
+    expect(_badge(page)).to_have_attribute("data-valid", "true")
+    # Every actor is a lane; every task sits inside its actor's lane.
+    for actor in document["actors"]:
+        lane = page.locator(f'[data-element-id="{actor["id"]}"]')
+        expect(lane).to_have_count(1)
+        band = lane.bounding_box()
+        assert band is not None
+        for process in document["processes"]:
+            for task in process["transitions"]:
+                if task.get("performer") != actor["id"]:
+                    continue
+                box = page.locator(f'[data-element-id="{task["id"]}"]').bounding_box()
+                assert box is not None
+                middle = box["y"] + box["height"] / 2
+                assert band["y"] <= middle <= band["y"] + band["height"], task["id"]
+    expect(page.locator(".djs-connection .hrc-constraint")).to_have_count(
+        len(document["constraints"])
+    )
+    screenshot(page, f"editor-{example}")
+
+
+# Drawing with the mouse: positions come from what is on screen, as a person aims.
+
+
+def _box(page: Page, element_id: str) -> FloatRect:
+    """The element's box on screen: its hit area, which is the shape's bounds."""
+    box = page.locator(f'[data-element-id="{element_id}"] .djs-hit').first.bounding_box()
+    assert box is not None, f"{element_id} is not on the canvas"
+    return box
+
+
+def _centre(page: Page, element_id: str) -> tuple[float, float]:
+    box = _box(page, element_id)
+    return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+
+
+def _click(page: Page, element_id: str) -> None:
+    page.mouse.click(*_centre(page, element_id))
+
+
+def _drop(page: Page, tool: str, x: float, y: float) -> None:
+    """Takes a node from the palette and drops it at (x, y)."""
+    page.get_by_role("button", name=tool, exact=True).click()
+    page.mouse.move(x, y, steps=6)
+    page.mouse.down()
+    page.mouse.up()
+
+
+def _pad(page: Page, action: str) -> None:
+    page.locator(f'.djs-context-pad.open [data-action="{action}"]').click()
+
+
+def _connect(page: Page, source: str, target: str, action: str = "connect") -> None:
+    """From the source's context pad, draws an arc (or a constraint) to the target."""
+    _click(page, source)
+    _pad(page, action)
+    x, y = _centre(page, target)
+    page.mouse.move(x, y, steps=8)
+    page.mouse.down()
+    page.mouse.up()
+
+
+def _append(page: Page, label: str = "") -> None:
+    """Appends the next node to the selected one with the A key; a task gets its label typed."""
+    selected = page.get_by_role("region", name="Properties").get_by_label("Id")
+    before = selected.input_value()
+    page.keyboard.press("a")
+    expect(selected).not_to_have_value(before)
+    if label:
+        field = page.locator(".hrc-label-input")
+        expect(field).to_be_focused()
+        page.keyboard.type(label)
+        page.keyboard.press("Enter")
+        expect(field).to_have_count(0)
+
+
+def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publishes(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/new/")
+    name = page.get_by_label("Pattern name")
+    name.fill("Assembly (1 operator, 1 cobot)")
+    name.press("Enter")
+
+    page.get_by_role("button", name="Cobot lane").click()
+    page.get_by_role("button", name="Operator lane").click()
+    cobot, operator = _box(page, "c"), _box(page, "o")
+
+    # The cobot's line: p1 (with the case's token), a split, pick, place and fix the insert.
+    _drop(page, "Place", cobot["x"] + 100, cobot["y"] + cobot["height"] / 2)
+    _pad(page, "token.add")
+    _pad(page, "append.silent")
+    _append(page)
+    for label in ("pick insert", "place insert", "fix insert"):
+        _append(page, label)
+        _append(page)
+    # The operator's line, in the operator's lane under p2.
+    p2_x, _ = _centre(page, "p2")
+    _drop(page, "Place", p2_x, operator["y"] + operator["height"] / 2)
+    for label in ("prepare workpiece", "check assembled insert"):
+        _append(page, label)
+        _append(page)
+    # The join and the end.
+    _click(page, "p5")
+    _pad(page, "append.silent")
+    _append(page)
+    page.get_by_role("button", name="Show all").click()
+    _connect(page, "t1", "p6")
+    _connect(page, "p8", "t2")
+    screenshot(page, "editor-drawing-assembly-net")
+    # The synchronisation: the cobot places only a prepared workpiece; the operator checks a fixed insert.
+    _connect(page, "to1", "tc2", "constraint.time")
+    _connect(page, "tc3", "to2", "constraint.time")
+
+    expect(_badge(page)).to_have_text("Synchronized", timeout=CHECKED)
+    expect(_badge(page)).to_have_attribute("data-valid", "true")
+    screenshot(page, "editor-drawn-assembly")
+
+    # A time constraint against the flow: the cobot's placing before the operator's preparing.
+    _connect(page, "tc2", "to1", "constraint.time")
+    expect(_badge(page)).to_have_attribute("data-sound", "false", timeout=CHECKED)
+    for task in ("tc2", "to1"):
+        expect(page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')).to_be_visible()
+    deadlock = page.locator(".hrc-issue", has_text="can deadlock")
+    expect(deadlock.locator(".hrc-witness-steps li")).to_have_text(
+        ["t1", "start tc1", "complete tc1"]
+    )
+    deadlock.get_by_role("button", name="Play the witness").click()
+    bar = page.get_by_role("toolbar", name="Token game")
+    for _ in range(3):
+        bar.get_by_role("button", name="Forward ▶").click()
+    expect(bar.locator(".hrc-game-caption")).to_contain_text("Witness replayed (3 of 3)")
+    # Where the witness ends: tc1 has completed, tc2 and to1 wait for each other.
+    expect(page.locator('.djs-element[data-element-id="tc1"]')).not_to_have_class(RUNNING)
+    expect(page.locator('.djs-element[data-element-id="p3"] .hrc-token')).to_have_count(1)
+    for task in ("tc2", "to1"):
+        expect(page.locator(f'.djs-element[data-element-id="{task}"]')).to_have_class(STUCK)
+    screenshot(page, "editor-assembly-deadlock-witness")
+    bar.get_by_role("button", name="Stop").click()
+
+    # Undo takes the contradiction back; the check agrees again.
+    _click(page, "p1")
+    page.keyboard.press("Control+z")
+    expect(_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    expect(_badge(page)).to_have_text("Synchronized")
+
+    page.get_by_role("button", name="Publish", exact=True).click()
+    expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text(
+        "Published version 1.", timeout=CHECKED
+    )
+    version = PatternVersion.objects.get()
+    assert version.number == 1
+    assert version.pattern.name == "Assembly (1 operator, 1 cobot)"
+    _assert_is_the_thesis_assembly(version.document)
+    screenshot(page, "editor-assembly-published")
+
+
+def _assert_is_the_thesis_assembly(document: dict[str, Any]) -> None:
+    """The drawn model is the thesis' CP_synch_1O1C: the same net, actors and constraints."""
+    thesis = json.loads((EXAMPLES / "synch_1o1c_assembly.json").read_text())
+    (process,) = document["processes"]
+    (expected,) = thesis["processes"]
+    assert {a["id"]: a["type"] for a in document["actors"]} == {"c": "cobot", "o": "operator"}
+    assert sorted(process["actors"]) == ["c", "o"]
+    assert sorted(p["id"] for p in process["places"]) == sorted(p["id"] for p in expected["places"])
+    assert {p["id"]: p.get("tokens") for p in process["places"] if p.get("tokens")} == {"p1": 1}
+
+    def tasks(net: dict[str, Any]) -> dict[str, tuple[str | None, str | None]]:
+        return {t["id"]: (t.get("performer"), t.get("label")) for t in net["transitions"]}
+
+    assert tasks(process) == tasks(expected)
+    assert sorted(map(tuple, process["arcs"])) == sorted(map(tuple, expected["arcs"]))
+    assert sorted((c["from"], c["to"], c["type"]) for c in document["constraints"]) == sorted(
+        (c["from"], c["to"], c["type"]) for c in thesis["constraints"]
+    )
+    assert all("layout" in node for node in process["places"] + process["transitions"])
+
+
+def _assembly(organisation: Organisation) -> PatternModel:
+    document = json.loads((EXAMPLES / "synch_1o1c_assembly.json").read_text())
+    return factories.make_pattern(organisation, draft=document, name=document["name"])
+
+
+def _import(page: Page, name: str, text: str) -> None:
+    payload = FilePayload(name=name, mimeType="application/octet-stream", buffer=text.encode())
+    page.get_by_label("Import a file").set_input_files(files=[payload])
+
+
+def _another_pattern(pattern: PatternModel) -> Callable[[str], bool]:
+    """Matches the editor's address for any pattern but this one."""
+    return lambda url: (
+        bool(re.search(r"/patterns/\d+/edit/$", url))
+        and not url.endswith(f"/patterns/{pattern.pk}/edit/")
+    )
+
+
+BROKEN_PNML = """<?xml version="1.0"?>
+<pnml>
+  <net id="N" type="http://www.pnml.org/version-2009/grammar/ptnet">
+    <place id="p1">
+  </net>
+</pnml>"""
+
+BPMN = """<?xml version="1.0" encoding="UTF-8"?>
+<definitions xmlns="http://www.omg.org/spec/BPMN/20100524/MODEL" id="d" targetNamespace="urn:t" name="Cell 4">
+  <process id="P">
+    <laneSet id="ls">
+      <lane id="robot" name="UR5e"><flowNodeRef>pick</flowNodeRef></lane>
+      <lane id="anna" name="Anna"><flowNodeRef>prepare</flowNodeRef></lane>
+    </laneSet>
+    <startEvent id="start"/>
+    <parallelGateway id="fork"/>
+    <task id="pick" name="pick insert"/>
+    <userTask id="prepare" name="prepare workpiece"/>
+    <parallelGateway id="join"/>
+    <endEvent id="done"/>
+    <sequenceFlow id="f1" sourceRef="start" targetRef="fork"/>
+    <sequenceFlow id="f2" sourceRef="fork" targetRef="pick"/>
+    <sequenceFlow id="f3" sourceRef="pick" targetRef="join"/>
+    <sequenceFlow id="f4" sourceRef="fork" targetRef="prepare"/>
+    <sequenceFlow id="f5" sourceRef="prepare" targetRef="join"/>
+    <sequenceFlow id="f6" sourceRef="join" targetRef="done"/>
+  </process>
+</definitions>"""
+
+
+# The import endpoint answers a browser's XML with 415: DRF's CSRF check for session users
+# parses the body, and the API has no XML parser (hrc/api). Reported; these turn into
+# failures (strict) as soon as it is fixed, to be made plain tests again.
+XML_IMPORT_REFUSED = pytest.mark.xfail(
+    strict=True,
+    reason="POST /api/patterns/import/ with an XML body and session auth is a 415 (CSRF check parses it)",
+)
+
+
+def test_a_malformed_file_changes_nothing_and_says_where(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    expect(_badge(page)).to_have_text("Synchronized", timeout=CHECKED)
+    nodes = page.locator(".djs-shape")
+    count = nodes.count()
+    status = page.locator(".hrc-toolbar .hrc-status")
+
+    _import(page, "cell4.pnml", BROKEN_PNML)
+    expect(status).to_have_attribute("role", "alert")
+    expect(status).to_contain_text("cell4.pnml is not well-formed XML")
+    expect(status).to_contain_text("line 5")
+    expect(status).to_contain_text("inside <place>")
+    screenshot(page, "editor-import-malformed-xml")
+
+    broken = json.loads((EXAMPLES / "synch_1o1c_assembly.json").read_text())
+    broken["processes"][0]["transitions"][3]["performer"] = ["c"]
+    _import(page, "cell4.json", json.dumps(broken))
+    expect(status).to_have_text(
+        "processes[0] (N).transitions[3] (tc2).performer must be a string, got a list of 1."
+    )
+    _import(page, "cell4.json", '{"format": "hrc-pattern/1",\n "actors": [}')
+    expect(status).to_have_text('The file is not JSON: unexpected "}" at line 2, column 13.')
+
+    expect(nodes).to_have_count(count)
+    assert page.url == f"{live_url}/patterns/{pattern.pk}/edit/"
+    assert PatternModel.objects.count() == 1
+    pattern.refresh_from_db()
+    assert pattern.draft == json.loads((EXAMPLES / "synch_1o1c_assembly.json").read_text())
+
+
+@XML_IMPORT_REFUSED
+def test_a_bpmn_feature_hrc_does_not_map_is_refused_by_element_and_changes_nothing(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    status = page.locator(".hrc-toolbar .hrc-status")
+    unmapped = BPMN.replace('<parallelGateway id="join"/>', '<inclusiveGateway id="join"/>')
+    _import(page, "cell4.bpmn", unmapped)
+    expect(status).to_have_attribute("data-kind", "error")
+    expect(status).to_contain_text("join")
+    expect(status).not_to_contain_text("Unsupported media type")
+    screenshot(page, "editor-import-unmapped-bpmn")
+    assert PatternModel.objects.count() == 1
+
+
+@XML_IMPORT_REFUSED
+def test_a_bpmn_file_imports_as_a_new_pattern_in_its_lanes(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    _import(page, "cell4.bpmn", BPMN)
+    page.wait_for_url(_another_pattern(pattern), timeout=CHECKED)
+    expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
+    for lane in ("robot", "anna"):
+        expect(page.locator(f'.djs-shape[data-element-id="{lane}"]')).to_have_count(1)
+    expect(page.locator(".djs-shape .hrc-task")).to_have_count(2)
+    screenshot(page, "editor-imported-bpmn")
+
+
+def test_a_pattern_file_imports_as_a_new_pattern_and_exports_as_bpmn_and_pnml(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    polishing = (EXAMPLES / "coop_1o1c_polishing.json").read_text()
+    _import(page, "polishing.json", polishing)
+    page.wait_for_url(_another_pattern(pattern), timeout=CHECKED)
+    imported = PatternModel.objects.exclude(pk=pattern.pk).get()
+    assert page.url.endswith(f"/patterns/{imported.pk}/edit/")
+    expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
+    expect(_badge(page)).to_have_text("Cooperation", timeout=CHECKED)
+    screenshot(page, "editor-imported-json")
+
+    for format, marker in (
+        ("bpmn", "http://www.omg.org/spec/BPMN/20100524/MODEL"),
+        ("pnml", "<pnml"),
+    ):
+        with page.expect_download() as download:
+            page.get_by_label("Export").select_option(format)
+        text = Path(download.value.path()).read_text()
+        assert marker in text
+        assert "polish" in text
+
+
+def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    page.get_by_role("button", name="Token game").click()
+    bar = page.get_by_role("toolbar", name="Token game")
+    caption = bar.locator(".hrc-game-caption")
+    expect(caption).to_have_text("Enabled: t1.")
+
+    def tokens(place: str) -> Any:
+        return page.locator(f'.djs-element[data-element-id="{place}"] .hrc-token')
+
+    expect(tokens("p1")).to_have_count(1)
+    _click(page, "tc1")  # not enabled yet: nothing happens
+    expect(caption).to_have_text("Enabled: t1.")
+    _click(page, "t1")
+    expect(tokens("p1")).to_have_count(0)
+    expect(tokens("p2")).to_have_count(1)
+    _click(page, "tc1")
+    expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
+    expect(caption).to_contain_text("Fired start tc1.")
+    _click(page, "tc1")
+    expect(caption).to_contain_text("Fired complete tc1.")
+    expect(tokens("p3")).to_have_count(1)
+
+    # The constraint places, on demand: tc2 waits for to1's completion.
+    bar.get_by_label("Constraint places").check()
+    expect(page.locator(".hrc-constraint-place", has_text="to1 done, for tc2: 0")).to_be_visible()
+    _click(page, "tc2")
+    expect(page.locator('.djs-element[data-element-id="tc2"]')).not_to_have_class(RUNNING)
+    screenshot(page, "editor-token-game")
+
+    bar.get_by_role("button", name="◀ Back").click()
+    expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
+    bar.get_by_role("button", name="Forward ▶").click()
+    expect(tokens("p3")).to_have_count(1)
+
+    bar.get_by_role("button", name="Run randomly").click()
+    expect(caption).to_contain_text("Nothing is enabled.", timeout=20_000)
+    expect(tokens("p9")).to_have_count(1)
+    # Nothing was edited by playing.
+    bar.get_by_role("button", name="Stop").click()
+    expect(page.get_by_role("button", name="Undo")).to_be_disabled()
+
+
+def test_a_refused_edit_says_why_and_draws_nothing(
+    page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    arcs = page.locator(".djs-connection .hrc-arc")
+    constraints = page.locator(".djs-connection .hrc-constraint")
+    count = arcs.count()
+    hint = page.locator(".hrc-refusal")
+
+    _connect(page, "p2", "p3")
+    expect(hint).to_have_text(
+        "An arc cannot join two places (p2 → p3): put a transition between them."
+    )
+    _connect(page, "tc1", "tc3", "constraint.func")
+    expect(hint).to_have_text(
+        "tc1 and tc3 are both tasks of c: a constraint joins tasks of different actors."
+    )
+    expect(arcs).to_have_count(count)
+    expect(constraints).to_have_count(2)
+    expect(page.get_by_role("button", name="Undo")).to_be_disabled()
+
+
+def test_an_outsider_gets_404_for_our_pattern(
+    page: Page, live_url: str, outsider: User, organisation: Organisation, sign_in: SignIn
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, outsider)
+    response = page.goto(f"{live_url}/patterns/{pattern.pk}/edit/")
+    assert response is not None
+    assert response.status == 404
+    page.goto(f"{live_url}/patterns/")
+    expect(page.get_by_text(pattern.name)).to_have_count(0)
+
+
+def test_an_operator_may_read_the_list_but_not_edit(
+    page: Page,
+    live_url: str,
+    operator: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, operator)
+    page.goto(f"{live_url}/patterns/")
+    expect(page.get_by_text(pattern.name)).to_be_visible()
+    expect(page.get_by_role("link", name=f"Open {pattern.name}")).to_have_count(0)
+    response = page.goto(f"{live_url}/patterns/{pattern.pk}/edit/")
+    assert response is not None
+    assert response.status == 403
+    expect(page.get_by_role("alert")).to_contain_text("Only engineers and admins")
+    expect(page.locator("#hrc-editor")).to_have_count(0)
+    screenshot(page, "editor-operator-refused")
