@@ -1,0 +1,1 @@
+"""Analytics of running cases: Gantt charts, cycle times, utilisation, waiting, XES export."""

@@ -1,0 +1,451 @@
+"""A case as a Gantt chart: the actors as rows, each work item a bar, each constraint arrows
+between the bars of its two tasks, interruptions marked on the cobot's bar.
+
+Pure functions over hrc.analytics.metrics' rows. `build_gantt` says what is in
+the chart (the API's answer); `draw_gantt` places it on a canvas for the
+server-rendered SVG (templates/analytics/_gantt.html).
+
+A bar has two parts: waiting (offered until started) and working (started
+until ended, or until now while it runs). Bars of one actor that overlap in
+time (two operators mapped to one actor, parallel branches) get separate lanes
+of the row, so none hides another.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections import defaultdict
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+
+from hrc.analytics.metrics import InterruptionRow, ItemRow, seconds
+
+_XOf = Callable[[dt.datetime], float]
+
+
+@dataclass(frozen=True)
+class ActorRow:
+    id: str
+    type: str
+    """cobot or operator."""
+    who: str
+    """Who performs the actor in this case: user names, a team, a cobot."""
+
+
+@dataclass(frozen=True)
+class ConstraintRow:
+    index: int
+    """Its position in the pattern document's constraints."""
+    source: str
+    target: str
+    type: str
+
+
+@dataclass(frozen=True)
+class Bar:
+    work_item: int
+    task: str
+    label: str
+    actor: str
+    kind: str
+    state: str
+    resource: str
+    offered_at: dt.datetime
+    started_at: dt.datetime | None
+    ended_at: dt.datetime | None
+    lane: int
+    """0 for the row's first lane."""
+
+    def until(self, now: dt.datetime) -> dt.datetime:
+        """Where the bar ends on the chart: its end, or now while it is open."""
+        return self.ended_at or now
+
+
+@dataclass(frozen=True)
+class GanttRow:
+    actor: str
+    type: str
+    who: str
+    lanes: int
+    bars: list[Bar]
+
+
+@dataclass(frozen=True)
+class Arrow:
+    """One constraint between two bars: from the source task's bar to the target task's.
+
+    `from_at` is where it leaves the source bar: its end when the source ended
+    before the target started, else the moment both ran (`overlapping`).
+    """
+
+    constraint: int
+    type: str
+    source: str
+    target: str
+    from_work_item: int
+    to_work_item: int
+    from_at: dt.datetime
+    to_at: dt.datetime
+    overlapping: bool
+
+
+@dataclass(frozen=True)
+class Mark:
+    """An interruption of a cobot's task while an operator worked in the shared space."""
+
+    interruption: int
+    work_item: int
+    operator_work_item: int
+    cobot: str
+    mode: str
+    started_at: dt.datetime
+    ended_at: dt.datetime | None
+    paused_at: dt.datetime | None
+    resumed_at: dt.datetime | None
+
+
+@dataclass(frozen=True)
+class Gantt:
+    case: int
+    start: dt.datetime
+    end: dt.datetime
+    """The case's end, or now while it runs."""
+    now: dt.datetime
+    open: bool
+    rows: list[GanttRow]
+    constraints: list[ConstraintRow]
+    arrows: list[Arrow]
+    marks: list[Mark]
+
+
+def build_gantt(
+    case: int,
+    *,
+    started_at: dt.datetime,
+    ended_at: dt.datetime | None,
+    now: dt.datetime,
+    actors: Sequence[ActorRow],
+    items: Iterable[ItemRow],
+    constraints: Sequence[ConstraintRow],
+    interruptions: Iterable[InterruptionRow],
+) -> Gantt:
+    """The chart of one case. Rows follow `actors` (the document's order); an item of an
+    actor not among them gets a row after them."""
+    by_actor: dict[str, list[ItemRow]] = defaultdict(list)
+    for item in sorted(items, key=lambda i: (i.offered_at, i.id)):
+        by_actor[item.actor].append(item)
+    known = [actor.id for actor in actors]
+    rows_of = list(actors) + [
+        ActorRow(actor, "", "") for actor in sorted(by_actor) if actor not in known
+    ]
+    rows = [_row(actor, by_actor.get(actor.id, []), now) for actor in rows_of]
+    bars = [bar for row in rows for bar in row.bars]
+    end = max(ended_at or now, started_at)
+    return Gantt(
+        case=case,
+        start=started_at,
+        end=end,
+        now=now,
+        open=ended_at is None,
+        rows=rows,
+        constraints=list(constraints),
+        arrows=[arrow for c in constraints for arrow in _arrows(c, bars, now)],
+        marks=[_mark(i) for i in sorted(interruptions, key=lambda i: (i.started_at, i.id))],
+    )
+
+
+def _row(actor: ActorRow, items: list[ItemRow], now: dt.datetime) -> GanttRow:
+    """The actor's bars, each in the first lane that is free when it is offered."""
+    lane_ends: list[dt.datetime] = []
+    bars = []
+    for item in items:
+        end = item.ended_at or now
+        lane = next((n for n, free in enumerate(lane_ends) if free <= item.offered_at), None)
+        if lane is None:
+            lane = len(lane_ends)
+            lane_ends.append(end)
+        else:
+            lane_ends[lane] = end
+        label = item.label or item.task
+        bar = Bar(
+            item.id, item.task, label, item.actor, item.kind, item.state, item.resource,
+            item.offered_at, item.started_at, item.ended_at, lane,
+        )  # fmt: skip
+        bars.append(bar)
+    return GanttRow(actor.id, actor.type, actor.who, max(len(lane_ends), 1), bars)
+
+
+def _arrows(constraint: ConstraintRow, bars: Sequence[Bar], now: dt.datetime) -> list[Arrow]:
+    """An arrow to each started bar of the target task from the source task's bar that goes
+    with it: one running at the same time (the nearest start), else the last one that
+    ended before it started. A target bar with neither gets none."""
+    sources = [b for b in bars if b.task == constraint.source and b.started_at is not None]
+    arrows = []
+    for target in bars:
+        if target.task != constraint.target or target.started_at is None:
+            continue
+        begin, finish = target.started_at, target.until(now)
+        overlapping = [s for s in sources if _start(s) <= finish and begin <= s.until(now)]
+        if overlapping:
+            source = min(overlapping, key=lambda s: (abs(seconds(_start(s), begin)), s.work_item))
+            at = max(_start(source), begin)
+            arrows.append(_arrow(constraint, source, target, at, at, overlapping=True))
+            continue
+        before = [s for s in sources if s.until(now) <= begin]
+        if before:
+            source = max(before, key=lambda s: (s.until(now), s.work_item))
+            arrows.append(
+                _arrow(constraint, source, target, source.until(now), begin, overlapping=False)
+            )
+    return arrows
+
+
+def _start(bar: Bar) -> dt.datetime:
+    assert bar.started_at is not None  # only started bars are arrow ends
+    return bar.started_at
+
+
+def _arrow(
+    constraint: ConstraintRow,
+    source: Bar,
+    target: Bar,
+    from_at: dt.datetime,
+    to_at: dt.datetime,
+    *,
+    overlapping: bool,
+) -> Arrow:
+    return Arrow(
+        constraint.index, constraint.type, constraint.source, constraint.target,
+        source.work_item, target.work_item, from_at, to_at, overlapping,
+    )  # fmt: skip
+
+
+def _mark(row: InterruptionRow) -> Mark:
+    return Mark(
+        row.id, row.work_item_id, row.operator_work_item_id, row.cobot, row.mode,
+        row.started_at, row.ended_at, row.paused_at, row.resumed_at,
+    )  # fmt: skip
+
+
+# Drawing ---------------------------------------------------------------------------------
+
+LABEL_WIDTH = 170  # the actors' names left of the chart
+RIGHT_MARGIN = 24
+TOP = 34  # the time axis above the rows
+LANE_HEIGHT = 36
+BAR_HEIGHT = 24
+WAIT_HEIGHT = 8
+ROW_PADDING = 6
+CHAR_WIDTH = 6.6  # an estimate for 12 px system-ui, to decide whether a label fits a bar
+# Tick spacings in seconds: the smallest that gives at most MAX_TICKS ticks is used.
+TICK_STEPS = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 14400, 28800, 86400)
+MAX_TICKS = 10
+
+
+@dataclass(frozen=True)
+class DrawnRow:
+    row: GanttRow
+    y: float
+    height: float
+    index: int
+
+    @property
+    def actor_y(self) -> float:
+        return self.y + 20
+
+    @property
+    def who_y(self) -> float:
+        return self.y + 36
+
+
+@dataclass(frozen=True)
+class DrawnBar:
+    bar: Bar
+    y: float
+    wait_x: float
+    wait_width: float
+    x: float | None
+    """The working part; None for a bar that never started."""
+    width: float
+    text: str
+    """The label as far as it fits the working part (may be empty)."""
+    seconds_waited: float | None
+    seconds_worked: float | None
+
+    @property
+    def middle(self) -> float:
+        return self.y + BAR_HEIGHT / 2
+
+    @property
+    def wait_y(self) -> float:
+        return self.middle - WAIT_HEIGHT / 2
+
+    @property
+    def text_x(self) -> float:
+        return (self.x or 0.0) + 5
+
+    @property
+    def text_y(self) -> float:
+        return self.y + BAR_HEIGHT / 2 + 4
+
+
+@dataclass(frozen=True)
+class DrawnArrow:
+    arrow: Arrow
+    path: str
+
+
+@dataclass(frozen=True)
+class DrawnMark:
+    mark: Mark
+    x: float
+    y: float
+    width: float
+    ongoing: bool
+
+    @property
+    def icon_y(self) -> float:
+        return self.y - 3
+
+
+@dataclass(frozen=True)
+class Tick:
+    x: float
+    label: str
+
+
+@dataclass(frozen=True)
+class GanttDrawing:
+    gantt: Gantt
+    width: float
+    height: float
+    left: float
+    right: float
+    top: float
+    rows: list[DrawnRow]
+    bars: list[DrawnBar]
+    arrows: list[DrawnArrow]
+    marks: list[DrawnMark]
+    ticks: list[Tick]
+    now_x: float | None
+    """Where now is, while the case is open."""
+
+    @property
+    def tick_y(self) -> float:
+        return self.top - 12
+
+    @property
+    def grid_top(self) -> float:
+        return self.top - 6
+
+
+def draw_gantt(gantt: Gantt, width: float = 1100) -> GanttDrawing:
+    """The chart laid out `width` pixels wide, time running left to right."""
+    right = width - RIGHT_MARGIN
+    span = max(seconds(gantt.start, gantt.end), 1.0)
+    scale = (right - LABEL_WIDTH) / span
+
+    def x_of(moment: dt.datetime) -> float:
+        return LABEL_WIDTH + max(0.0, min(seconds(gantt.start, moment), span)) * scale
+
+    rows, bars, y = [], {}, float(TOP)
+    for index, row in enumerate(gantt.rows):
+        height = row.lanes * LANE_HEIGHT + 2 * ROW_PADDING
+        rows.append(DrawnRow(row, y, height, index))
+        for bar in row.bars:
+            bars[bar.work_item] = _drawn_bar(
+                bar,
+                y + ROW_PADDING + bar.lane * LANE_HEIGHT + (LANE_HEIGHT - BAR_HEIGHT) / 2,
+                x_of,
+                gantt.now,
+            )
+        y += height
+    arrows = [
+        DrawnArrow(
+            a,
+            _arrow_path(
+                bars[a.from_work_item], bars[a.to_work_item], x_of(a.from_at), x_of(a.to_at)
+            ),
+        )
+        for a in gantt.arrows
+        if a.from_work_item in bars and a.to_work_item in bars
+    ]
+    marks = []
+    for mark in gantt.marks:
+        drawn = bars.get(mark.work_item)
+        if drawn is None:
+            continue
+        left = x_of(mark.started_at)
+        marks.append(
+            DrawnMark(
+                mark,
+                left,
+                drawn.y,
+                max(x_of(mark.ended_at or gantt.now) - left, 2.0),
+                mark.ended_at is None,
+            )
+        )
+    return GanttDrawing(
+        gantt=gantt,
+        width=width,
+        height=y + 8,
+        left=LABEL_WIDTH,
+        right=right,
+        top=TOP,
+        rows=rows,
+        bars=list(bars.values()),
+        arrows=arrows,
+        marks=marks,
+        ticks=_ticks(span, scale),
+        now_x=x_of(gantt.now) if gantt.open else None,
+    )
+
+
+def _drawn_bar(bar: Bar, y: float, x_of: _XOf, now: dt.datetime) -> DrawnBar:
+    until = bar.until(now)
+    wait_end = bar.started_at or until
+    wait_x = x_of(bar.offered_at)
+    wait_width = max(x_of(wait_end) - wait_x, 0.0)
+    worked = seconds(bar.started_at, until) if bar.started_at else None
+    if bar.started_at is None:
+        return DrawnBar(
+            bar, y, wait_x, wait_width, None, 0.0, "", seconds(bar.offered_at, until), None
+        )
+    x = x_of(bar.started_at)
+    width = max(x_of(until) - x, 3.0)  # an instant's work still shows
+    return DrawnBar(
+        bar, y, wait_x, wait_width, x, width, _fit(bar.label, width),
+        seconds(bar.offered_at, bar.started_at), worked,
+    )  # fmt: skip
+
+
+def _fit(text: str, width: float) -> str:
+    room = int((width - 8) / CHAR_WIDTH)
+    if room >= len(text):
+        return text
+    return text[: room - 1] + "…" if room >= 4 else ""
+
+
+def _arrow_path(source: DrawnBar, target: DrawnBar, x1: float, x2: float) -> str:
+    """Out of the source bar towards the target's row, into the target bar's near edge: an
+    elbow when the source ended before the target began, a straight drop when both ran."""
+    down = target.y > source.y
+    into = target.y if down else target.y + BAR_HEIGHT
+    if x2 - x1 > 2:
+        return f"M {x1:.1f} {source.middle:.1f} H {x2:.1f} V {into:.1f}"
+    out = source.y + BAR_HEIGHT if down else source.y
+    return f"M {x1:.1f} {out:.1f} V {into:.1f}"
+
+
+def _ticks(span: float, scale: float) -> list[Tick]:
+    step = next((s for s in TICK_STEPS if span / s <= MAX_TICKS), TICK_STEPS[-1])
+    count = int(span // step)
+    return [Tick(LABEL_WIDTH + n * step * scale, format_offset(n * step)) for n in range(count + 1)]
+
+
+def format_offset(total: float) -> str:
+    """Seconds since the case started as m:ss, or h:mm:ss from an hour on."""
+    whole = int(total)
+    hours, rest = divmod(whole, 3600)
+    minutes, secs = divmod(rest, 60)
+    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
