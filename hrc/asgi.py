@@ -13,7 +13,9 @@ http = get_asgi_application()
 from channels.auth import AuthMiddlewareStack  # noqa: E402
 from channels.routing import ProtocolTypeRouter, URLRouter  # noqa: E402
 from channels.security.websocket import AllowedHostsOriginValidator  # noqa: E402
+from django.conf import settings  # noqa: E402
 
+from hrc.embedded import EmbeddedServices  # noqa: E402
 from hrc.live.routing import websocket_urlpatterns  # noqa: E402
 
 application = ProtocolTypeRouter(
@@ -24,3 +26,5 @@ application = ProtocolTypeRouter(
         ),
     }
 )
+if settings.HRC_INLINE_TASKS:  # no Redis: the sweeper and the cobot monitor run in this server
+    application = EmbeddedServices(application)

@@ -2,14 +2,16 @@
 
 import io
 import json
+import re
 from pathlib import Path
 
 import pytest
 from django.contrib.auth.models import User
 from django.core.management import CommandError, call_command
 
+from hrc.cases import services as case_services
 from hrc.cobots.models import Cobot
-from hrc.organisations.models import Membership, Organisation
+from hrc.organisations.models import Membership, Organisation, Team
 from hrc.patterns.management.commands.load_demo import EXAMPLES_DIR
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
@@ -21,6 +23,10 @@ def _load_demo(*args: str) -> str:
     return out.getvalue()
 
 
+def _passwords(output: str) -> dict[str, str]:
+    return dict(re.findall(r"^\s+(\S+)\s+password (\S+)", output, re.MULTILINE))
+
+
 @pytest.mark.django_db
 def test_it_creates_the_demo_plant_with_people_who_can_sign_in() -> None:
     output = _load_demo()
@@ -28,17 +34,75 @@ def test_it_creates_the_demo_plant_with_people_who_can_sign_in() -> None:
     roles = dict(
         Membership.objects.filter(organisation=organisation).values_list("user__username", "role")
     )
-    assert roles == {"admin": "admin", "engineer": "engineer", "operator": "operator"}
-    for username in roles:
-        assert User.objects.get(username=username).check_password(f"demo-{username}")
-        assert f"demo-{username}" in output
+    assert roles == {
+        "admin": "admin",
+        "engineer": "engineer",
+        "operator1": "operator",
+        "operator2": "operator",
+    }
+    passwords = _passwords(output)
+    assert set(passwords) == set(roles)
+    for username, password in passwords.items():
+        assert User.objects.get(username=username).check_password(password)
+        assert username not in password
+    assert len(set(passwords.values())) == len(passwords)
     admin = User.objects.get(username="admin")
     assert admin.is_staff
     assert admin.is_superuser
-    assert not User.objects.get(username="operator").is_staff
+    assert not User.objects.get(username="operator1").is_staff
+    team = Team.objects.get(organisation=organisation)
+    assert sorted(team.members.values_list("user__username", flat=True)) == [
+        "operator1",
+        "operator2",
+    ]
     cobots = Cobot.objects.filter(organisation=organisation)
-    assert cobots.count() >= 2
+    assert sorted(cobots.values_list("name", "endpoint")) == [
+        ("cobot1", "opc.tcp://127.0.0.1:4841"),
+        ("cobot2", "opc.tcp://127.0.0.1:4842"),
+    ]
     assert {c.driver for c in cobots} == {"simulated"}
+
+
+@pytest.mark.django_db
+def test_running_it_again_prints_new_passwords_and_the_old_ones_stop_working() -> None:
+    first = _passwords(_load_demo())
+    second = _passwords(_load_demo())
+    for username in first:
+        user = User.objects.get(username=username)
+        assert second[username] != first[username]
+        assert user.check_password(second[username])
+        assert not user.check_password(first[username])
+
+
+@pytest.mark.django_db
+def test_keep_passwords_leaves_them_and_prints_none() -> None:
+    first = _passwords(_load_demo())
+    output = _load_demo("--keep-passwords")
+    assert set(_passwords(output).values()) == {"(unchanged)"}
+    for username, password in first.items():
+        assert User.objects.get(username=username).check_password(password)
+        assert password not in output
+
+
+@pytest.mark.django_db
+def test_every_example_can_start_a_case_with_the_demo_people_and_cobots() -> None:
+    _load_demo("--strict")
+    organisation = Organisation.objects.get(slug="demo-plant")
+    team = Team.objects.get(organisation=organisation)
+    cobots = set(Cobot.objects.filter(organisation=organisation).values_list("pk", flat=True))
+    versions = PatternVersion.objects.filter(pattern__organisation=organisation)
+    assert versions.exists()
+    for version in versions:
+        actors = {actor["id"]: actor["type"] for actor in version.document["actors"]}
+        mapping = version.default_actor_mapping
+        assert set(mapping) == set(actors), version
+        for actor, kind in actors.items():
+            if kind == "cobot":
+                assert mapping[actor]["cobot"] in cobots
+            else:
+                assert mapping[actor] == {"team": team.pk}
+        case = case_services.start_case(version, started_by=User.objects.get(username="engineer"))
+        assert case.status == "running"
 
 
 @pytest.mark.django_db
@@ -59,12 +123,12 @@ def test_running_it_twice_changes_nothing() -> None:
     _load_demo()
     counts = [
         model.objects.count()
-        for model in (Organisation, User, Membership, Cobot, PatternModel, PatternVersion)
+        for model in (Organisation, User, Membership, Team, Cobot, PatternModel, PatternVersion)
     ]
     output = _load_demo()
     assert counts == [
         model.objects.count()
-        for model in (Organisation, User, Membership, Cobot, PatternModel, PatternVersion)
+        for model in (Organisation, User, Membership, Team, Cobot, PatternModel, PatternVersion)
     ]
     assert "unchanged" in output
 

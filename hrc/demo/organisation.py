@@ -1,0 +1,165 @@
+"""The demo organisation: "Demo plant", one person per persona, a team and two simulated cobots.
+
+`manage.py load_demo`, `manage.py demo` and the browser test of the personas
+all provision through `provision`, so what the test signs in as is what a
+person trying the demo gets. Passwords are generated here with `secrets` and
+handed back to the caller to print once; only Django's hash of each is kept.
+"""
+
+from __future__ import annotations
+
+import secrets
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from django.contrib.auth.models import User
+from django.db import transaction
+
+from hrc.cobots import services as cobot_services
+from hrc.cobots.choices import DriverKind
+from hrc.cobots.models import Cobot
+from hrc.organisations import services as organisation_services
+from hrc.organisations.choices import Role
+from hrc.organisations.models import Membership, Organisation, Team
+
+ORGANISATION_NAME = "Demo plant"
+ORGANISATION_SLUG = "demo-plant"
+TEAM_NAME = "Line operators"
+
+
+@dataclass(frozen=True)
+class Persona:
+    """A demo user: their role in the demo organisation and the pages they start from."""
+
+    username: str
+    role: Role
+    staff: bool = False
+
+    @property
+    def pages(self) -> tuple[str, ...]:
+        """Paths of the pages this persona works in, first the one to open."""
+        if self.role == Role.OPERATOR:
+            return ("/tablet/",)
+        supervisor = ("/patterns/", "/cases/", "/incidents/")
+        return (*supervisor, "/admin/") if self.staff else supervisor
+
+
+PERSONAS = (
+    Persona("admin", Role.ADMIN, staff=True),
+    Persona("engineer", Role.ENGINEER),
+    Persona("operator1", Role.OPERATOR),
+    Persona("operator2", Role.OPERATOR),
+)
+
+
+@dataclass(frozen=True)
+class DemoCobot:
+    """A simulated cobot of the demo and the loopback port its gateway serves on by default."""
+
+    name: str
+    port: int
+
+    def endpoint(self, port: int | None = None) -> str:
+        return f"opc.tcp://127.0.0.1:{port or self.port}"
+
+
+DEMO_COBOTS = (DemoCobot("cobot1", 4841), DemoCobot("cobot2", 4842))
+
+
+@dataclass
+class DemoOrganisation:
+    organisation: Organisation
+    users: dict[str, User]
+    # username → the password just set, or None when the user kept theirs (--keep-passwords).
+    passwords: dict[str, str | None]
+    team: Team
+    cobots: list[Cobot]
+
+
+def generate_password() -> str:
+    """16 URL-safe characters (96 bits) from the operating system's randomness."""
+    return secrets.token_urlsafe(12)
+
+
+@transaction.atomic
+def provision(
+    cobot_ports: Mapping[str, int] | None = None, *, keep_passwords: bool = False
+) -> DemoOrganisation:
+    """Makes the demo organisation complete and returns it with the passwords it set.
+
+    Every persona gets a new generated password unless `keep_passwords` and
+    the user already has one. Each demo cobot is (re)pointed at its
+    gateway's loopback port (`cobot_ports` by name, else DemoCobot.port),
+    unsecured, active. Safe to call again: nothing is duplicated.
+    """
+    organisation = Organisation.objects.filter(slug=ORGANISATION_SLUG).first()
+    if organisation is None:
+        organisation = organisation_services.create_organisation(
+            name=ORGANISATION_NAME, slug=ORGANISATION_SLUG
+        )
+    users: dict[str, User] = {}
+    passwords: dict[str, str | None] = {}
+    for persona in PERSONAS:
+        users[persona.username], passwords[persona.username] = _ensure_member(
+            organisation, persona, keep_passwords
+        )
+    team = _ensure_team(
+        organisation, [users[p.username] for p in PERSONAS if p.role == Role.OPERATOR]
+    )
+    ports = cobot_ports or {}
+    cobots = [
+        _ensure_cobot(organisation, cobot.name, cobot.endpoint(ports.get(cobot.name)))
+        for cobot in DEMO_COBOTS
+    ]
+    return DemoOrganisation(organisation, users, passwords, team, cobots)
+
+
+def _ensure_member(
+    organisation: Organisation, persona: Persona, keep_password: bool
+) -> tuple[User, str | None]:
+    existing = User.objects.filter(username=persona.username).first()
+    password: str | None = None
+    if existing is not None and keep_password and existing.has_usable_password():
+        user = existing
+    else:
+        password = generate_password()
+        user = organisation_services.provision_user(
+            persona.username, password=password, is_staff=persona.staff, is_superuser=persona.staff
+        )
+    membership = Membership.objects.filter(organisation=organisation, user=user).first()
+    if membership is None:
+        organisation_services.add_member(organisation, user, persona.role)
+    elif membership.role != persona.role:
+        organisation_services.change_role(membership, persona.role)
+    return user, password
+
+
+def _ensure_team(organisation: Organisation, operators: list[User]) -> Team:
+    team = Team.objects.filter(organisation=organisation, name=TEAM_NAME).first()
+    if team is None:
+        team = organisation_services.create_team(organisation, name=TEAM_NAME)
+    memberships = Membership.objects.filter(organisation=organisation, user__in=operators)
+    return organisation_services.set_team_members(team, memberships)
+
+
+def _ensure_cobot(organisation: Organisation, name: str, endpoint: str) -> Cobot:
+    """The simulated cobot `name` at `endpoint`, where the demo starts its gateway."""
+    settings = {"driver": DriverKind.SIMULATED, "endpoint": endpoint, "credentials_source": "none"}
+    cobot = organisation.cobots.filter(name=name).first()
+    if cobot is None:
+        return cobot_services.create_cobot(organisation, name=name, **settings)
+    changed = {
+        field: value for field, value in {**settings, "is_active": True}.items()
+        if getattr(cobot, field) != value
+    }  # fmt: skip
+    return cobot_services.update_cobot(cobot, **changed) if changed else cobot
+
+
+def credential_lines(demo: DemoOrganisation) -> list[str]:
+    """The personas' user names and passwords, a line each, to print once."""
+    lines = ["Sign in with (the passwords are shown only now; run again for new ones):"]
+    for persona in PERSONAS:
+        password = demo.passwords[persona.username]
+        shown = password if password is not None else "(unchanged)"
+        lines.append(f"  {persona.username:<10} password {shown:<18} {Role(persona.role).label}")
+    return lines
