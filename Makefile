@@ -34,16 +34,10 @@ $(STAMP): requirements/lock.txt
 
 install: $(STAMP) $(FRONTEND_BUILD)  ## create .venv, install the locked Python and npm dependencies, build the frontend (idempotent)
 
-demo: install  ## load the example library, start two simulated cobots, serve on 127.0.0.1:8000
+demo: install  ## migrate, load the demo people and examples, start two simulated cobots and the server on 127.0.0.1:8000 (Ctrl-C stops all)
 	@mkdir -p var  # the embedded SQLite database lives here when DATABASE_URL is unset
-	$(PY) manage.py migrate --noinput
-	$(PY) manage.py load_demo
-	@# The demo's cobots: simulated gateways on loopback (insecure is allowed only there),
-	@# stopped with the server.
-	$(PY) manage.py cobot_gateway --name cobot1 --port 4841 --insecure > var/cobot1.log 2>&1 & \
-	$(PY) manage.py cobot_gateway --name cobot2 --port 4842 --insecure > var/cobot2.log 2>&1 & \
-	trap 'kill %1 %2 2>/dev/null' EXIT; \
-	$(PY) manage.py runserver 127.0.0.1:8000
+	@# hrc/patterns/management/commands/demo.py: prints the passwords once; e.g. DEMO_ARGS="--port 8001"
+	$(PY) manage.py demo $(DEMO_ARGS)
 
 $(CHROMIUM):
 	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
