@@ -22,6 +22,7 @@ from urllib.parse import parse_qs
 
 from channels.db import database_sync_to_async
 from channels.generic.websocket import AsyncJsonWebsocketConsumer
+from channels.layers import InMemoryChannelLayer
 
 from hrc.cobots.validators import validate_cell
 from hrc.live import broadcast, selectors
@@ -32,6 +33,8 @@ from hrc.live.selectors import Access
 RECHECK_SECONDS = 5.0
 # At most 10 cobot-state frames a second per tablet.
 STATE_INTERVAL = 0.1
+# Event types about one cobot: only its cell's tablets (and the whole floor's) get them.
+CELL_SCOPED = frozenset({"cobot-state", "cobot-queue"})
 UNAUTHENTICATED = 4401
 FORBIDDEN = 4403
 
@@ -42,7 +45,8 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
     groups_joined: list[str]
 
     async def connect(self) -> None:
-        broadcast.server_loop = asyncio.get_running_loop()
+        if isinstance(self.channel_layer, InMemoryChannelLayer):
+            broadcast.server_loop = asyncio.get_running_loop()  # the embedded demo's layer
         self.groups_joined = []
         self._states: dict[int, CobotStateData] = {}
         self._state_flush: asyncio.TimerHandle | None = None
@@ -86,30 +90,41 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
 
     # The channel layer's message, then one handler per event type ------------------------
 
-    async def live_event(self, message: dict[str, Any]) -> None:
-        event = message["event"]
-        if not await self._may_see(message):
+    async def live_events(self, message: dict[str, Any]) -> None:
+        """The deltas of one commit: each goes through its type's handler, which says whether it
+        goes out now; those that do go in one frame (the sender's encoding, when it is all)."""
+        events = message["events"]
+        if not self._organisation_matches(message):
             return
-        handler = self._HANDLERS.get(event.get("type"))
-        if handler is not None:
-            await handler(self, event)
+        forwarded = []
+        for event, cell in zip(events, message["cells"], strict=True):
+            handler = self._HANDLERS.get(event.get("type"))
+            if handler is not None and self._cell_matches(cell, event) and handler(self, event):
+                forwarded.append(event)
+        if len(forwarded) == len(events):
+            await self.send(text_data=message["text"])
+        elif forwarded:
+            await self.send_json(forwarded)
 
-    async def on_case(self, event: LiveEvent) -> None:
-        await self.send_json(event)
+    # One handler per event type: True sends it now.
 
-    async def on_work_item(self, event: LiveEvent) -> None:
-        await self.send_json(event)
+    def on_case(self, event: LiveEvent) -> bool:
+        return True
 
-    async def on_incident(self, event: LiveEvent) -> None:
-        await self.send_json(event)
+    def on_work_item(self, event: LiveEvent) -> bool:
+        return True
 
-    async def on_cobot_queue(self, event: LiveEvent) -> None:
-        await self.send_json(event)
+    def on_incident(self, event: LiveEvent) -> bool:
+        return True
 
-    async def on_cell_stop(self, event: LiveEvent) -> None:
-        await self.send_json(event)
+    def on_cobot_queue(self, event: LiveEvent) -> bool:
+        return True
 
-    async def on_cobot_state(self, event: LiveEvent) -> None:
+    def on_cell_stop(self, event: LiveEvent) -> bool:
+        return True
+
+    def on_cobot_state(self, event: LiveEvent) -> bool:
+        """Kept: the latest state per cobot goes out at most every STATE_INTERVAL."""
         for state in event["states"]:  # type: ignore[typeddict-item]
             self._states[state["cobot"]] = state
         if self._state_flush is None:
@@ -117,6 +132,7 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             self._state_flush = asyncio.get_running_loop().call_later(
                 wait, lambda: asyncio.ensure_future(self._flush_states())
             )
+        return False
 
     _HANDLERS = {
         "case": on_case,
@@ -136,13 +152,15 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             self._last_state_frame = time.monotonic()
             await self.send_json({"type": "cobot-state", "states": states})
 
-    async def _may_see(self, message: dict[str, Any]) -> bool:
-        """The event is this organisation's (and this cell's), and the user is still a member."""
+    def _organisation_matches(self, message: dict[str, Any]) -> bool:
+        """The socket's user is (as of the last membership check) a member of the message's
+        organisation; checked before every send."""
         access = self.access
-        if access is None or message.get("organisation") != access.organisation_id:
-            return False
-        cell = message.get("cell", "")
-        return not self.cell or cell == self.cell or message["event"].get("type") == "cell-stop"
+        return access is not None and message.get("organisation") == access.organisation_id
+
+    def _cell_matches(self, cell: str, event: LiveEvent) -> bool:
+        """A cobot's deltas reach its cell's tablets and the whole floor's; the rest every tablet."""
+        return event["type"] not in CELL_SCOPED or not self.cell or cell == self.cell
 
     async def revoke(self) -> None:
         """The membership is gone (Memberships found it): nothing more is sent."""

@@ -2,7 +2,9 @@
 
 Mirrored exactly in frontend/src/live/events.ts (a test compares the two).
 
-The protocol. On connect the server sends a `snapshot`; after it, deltas.
+The protocol. On connect the server sends a `snapshot`; after it, deltas. A
+frame holds one event (a JSON object) or several in order (a JSON array: the
+deltas of one commit).
 Case deltas (`case`, `work-item`, `incident`) are numbered per case: their
 `seq` is the case's event number (CaseEvent.seq), so each case is a stream
 1, 2, 3… with no holes. A tablet applies seq = known + 1, ignores seq ≤ known

@@ -25,9 +25,16 @@ async def open_socket(
     return await connect(f"{server.ws_url}/ws/live/{query}", additional_headers=headers)
 
 
+_pending: dict[int, list[dict[str, Any]]] = {}
+
+
 async def receive(socket: ClientConnection, timeout: float = 10.0) -> dict[str, Any]:
-    message: dict[str, Any] = json.loads(await asyncio.wait_for(socket.recv(), timeout))
-    return message
+    """The next event; a frame with several (one commit's) yields them one by one."""
+    waiting = _pending.setdefault(id(socket), [])
+    if not waiting:
+        frame = json.loads(await asyncio.wait_for(socket.recv(), timeout))
+        waiting.extend(frame if isinstance(frame, list) else [frame])
+    return waiting.pop(0)
 
 
 async def receive_until(

@@ -1,5 +1,6 @@
 // What goes over the tablets' WebSocket: the mirror of hrc/live/events.py, field for field
-// (tests/live/test_events_mirror.py compares the two). The protocol is explained there.
+// (tests/live/test_events_mirror.py compares the two). The protocol is explained there; a
+// frame is one LiveEvent or an array of them (the deltas of one commit, in order).
 
 export interface CaseData {
   id: number;

@@ -74,7 +74,11 @@ export class LiveSocket {
     this.setStatus(this.attempts === 0 ? "connecting" : "reconnecting", "");
     const socket = this.options.open(this.options.url);
     this.socket = socket;
-    socket.onmessage = (message) => this.receive(JSON.parse(String(message.data)) as LiveEvent);
+    socket.onmessage = (message) => {
+      // One event, or the events of one commit in order.
+      const data = JSON.parse(String(message.data)) as LiveEvent | LiveEvent[];
+      for (const event of Array.isArray(data) ? data : [data]) this.receive(event);
+    };
     socket.onclose = (event) => this.closed(event.code, event.reason);
   }
 
