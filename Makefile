@@ -60,6 +60,7 @@ bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC 
 	$(PY) -m bench.run
 	$(PY) -m bench.handshake
 	$(PY) -m bench.runtime
+	$(PY) -m bench.editor
 	$(PY) -m bench.live
 
 lock:  ## re-resolve requirements/*.in into the lock files
