@@ -167,3 +167,22 @@ def test_a_member_who_leaves_the_organisation_is_cut_off(
             await receive(socket, timeout=5)
 
     run(scenario())
+
+
+def test_a_cell_tablet_gets_the_case_deltas_too(
+    server: LiveServer, operator: User, choice_case: Case
+) -> None:
+    cookie = session_cookie(operator)
+    [count] = WorkItem.objects.filter(case=choice_case)
+
+    async def scenario() -> None:
+        await db(broadcast.flush)
+        socket = await open_socket(server, cookie, "?cell=A")
+        snapshot = await receive(socket)
+        assert snapshot["cell"] == "A"
+        await db(case_services.claim_work_item, count, user=operator)
+        await db(broadcast.flush)
+        delta = await receive_until(socket, lambda e: e["type"] == "work-item")
+        assert delta["event"] == "task-claimed"
+
+    run(scenario())
