@@ -80,7 +80,9 @@ class Command(BaseCommand):
         if settings.REDIS_URL:
             _check_redis(settings.REDIS_URL)
         # SIGTERM ends the demo as Ctrl-C does: through the `finally` that stops the children.
+        # SIGINT too, even when started with it ignored (a background job of a script).
         signal.signal(signal.SIGTERM, _interrupt)
+        signal.signal(signal.SIGINT, _interrupt)
         self.say(f"Database: {_database()}; migrating")
         call_command("migrate", interactive=False, verbosity=0)
         demo_organisation = self.load(plan, options["keep_passwords"])
