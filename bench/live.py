@@ -115,6 +115,7 @@ class Tablets:
         self._seen: dict[int, float] = {}
         self._all_seen = threading.Event()
         self._tasks: list[asyncio.Task[None]] = []
+        self.closed: list[int] = []
 
     def start(self) -> None:
         self.thread.start()
@@ -126,7 +127,7 @@ class Tablets:
         for index, tablet in enumerate(self.tablets):
             socket = await connect(
                 self.ws_url, additional_headers={"Cookie": tablet.cookie, "Origin": self.origin},
-                max_queue=None,
+                max_queue=None, ping_interval=None,  # the server pings; a loaded machine is slow
             )  # fmt: skip
             snapshot = json.loads(await socket.recv())
             if snapshot.get("type") != "snapshot":
@@ -139,6 +140,7 @@ class Tablets:
             frame = json.loads(raw)
             for event in frame if isinstance(frame, list) else [frame]:
                 self._apply(index, tablet, event)
+        self.closed.append(index)  # the server closed it: wait() says so
 
     def _apply(self, index: int, tablet: Tablet, event: dict[str, Any]) -> None:
         """Applies a case delta in seq order (a hole is counted) and notes the awaited event."""
@@ -167,7 +169,10 @@ class Tablets:
     def wait(self, timeout: float = 30.0) -> list[float]:
         """perf_counter() per tablet at which it had the expected event."""
         if not self._all_seen.wait(timeout):
-            raise TimeoutError(f"{len(self._seen)} of {len(self.tablets)} tablets had the event")
+            raise TimeoutError(
+                f"{len(self._seen)} of {len(self.tablets)} tablets had the event; "
+                f"sockets the server closed: {self.closed or 'none'}"
+            )
         return list(self._seen.values())
 
     def close(self) -> None:
