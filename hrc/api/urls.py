@@ -8,4 +8,5 @@ urlpatterns = [
     path("", include("hrc.cobots.api.urls")),
     path("", include("hrc.cases.api.urls")),
     path("", include("hrc.live.api.urls")),
+    path("", include("hrc.analytics.api.urls")),
 ]

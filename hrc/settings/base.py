@@ -36,6 +36,7 @@ INSTALLED_APPS = [
     "hrc.cobots",
     "hrc.cases",
     "hrc.live",
+    "hrc.analytics",
 ]
 
 MIDDLEWARE = [
