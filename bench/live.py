@@ -473,8 +473,9 @@ def measure_floor(bench: Rig, settings: Settings) -> dict[str, Any]:
 
 
 def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
-    from bench.runtime import machine
+    from bench.runtime import _load, machine
 
+    load_before = _load()
     with rig(settings, progress) as bench:
         host = machine()
         floor = measure_floor(bench, settings)
@@ -483,6 +484,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "benchmark": "live",
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
+        "load_average": {"before": load_before, "after": _load()},
         "settings": {k: v for k, v in asdict(settings).items() if k != "results_dir"},
         "pattern": SHAPE,
         **ours,
@@ -516,6 +518,9 @@ def print_table(report: Mapping[str, Any]) -> None:
           f"holes seen by tablets: {report['holes']}")  # fmt: skip
     verdict = "meets" if report["meets_target"] else "MISSES"
     print(f"target p99 <= {TARGET_P99_MS:g} ms: {verdict}")
+    load, cores = report["load_average"]["before"], report["machine"]["cpu_count"]
+    if load:
+        print(f"load average {load[0]:.2f} on {cores} cores at the start; compare quiet runs only")
 
 
 def parse_args(argv: Sequence[str] | None = None) -> Settings:
