@@ -59,7 +59,8 @@ def start_case(
     actor_mapping: Mapping[str, Any] | None = None,
     data: Mapping[str, Any] | None = None,
 ) -> Case:
-    """Starts a case of a published version; the mapping overrides the version's defaults per actor.
+    """Starts a case of a published version; the mapping overrides the version's defaults per actor,
+    `data` the pattern's initial data per key.
 
     Raises Invalid when an actor is left unmapped or mapped to someone outside the organisation.
     """
@@ -74,7 +75,7 @@ def start_case(
             organisation=organisation,
             version=version,
             marking=dict(net.initial),
-            data=dict(data or {}),
+            data={**net.initial_data(), **(data or {})},  # the pattern's `data`, then the case's
             actor_mapping=mapping,
             started_by=started_by,
         )

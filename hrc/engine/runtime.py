@@ -2,8 +2,8 @@
 
 A `CaseNet` is a published pattern compiled once for running: its execution
 net (execution.py), each task's configuration, the guards and messages of
-its silent transitions, and the operator/cobot pairs of its space
-constraints. It holds no case state: every method takes the marking (and
+its silent transitions, the operator/cobot pairs of its space constraints,
+and the data its cases start with. It holds no case state: every method takes the marking (and
 case data) and returns the next marking, so the database row stays the one
 truth and the same rule serves the runtime, the token game and the tests.
 
@@ -16,6 +16,7 @@ truth and the same rule serves the runtime, the token game and the tests.
   (`space_partners`).
 """
 
+import copy
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Final
@@ -28,6 +29,7 @@ from hrc.engine.taskconfig import (
     MessageConfig,
     TaskConfig,
     guard_of,
+    initial_data,
     message_of,
     task_config,
 )
@@ -60,6 +62,7 @@ class CaseNet:
         self.net = build_execution_net(pattern)
         self._transitions = {t.id: t for t in self.net.transitions}
         self._needs = {place: c.needed() for place, c in constraint_places(pattern).items()}
+        self._initial_data = initial_data(pattern)
         self.tasks: dict[str, TaskConfig] = {}
         self.performers: dict[str, str] = {}
         self.labels: dict[str, str] = {}
@@ -99,6 +102,10 @@ class CaseNet:
                 mode = "slow" if constraint.extra.get("interrupt") == "slow" else "pause"
                 pairs.append(SpacePair(kinds["operator"], kinds["cobot"], mode))
         return tuple(pairs)
+
+    def initial_data(self) -> dict[str, Any]:
+        """The data a case starts with, a copy of its own (compiled nets are shared)."""
+        return copy.deepcopy(self._initial_data)
 
     def transition(self, transition_id: str) -> NetTransition:
         return self._transitions[transition_id]

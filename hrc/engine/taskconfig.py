@@ -18,6 +18,10 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
 - `"message"` on a silent transition: `{"name": "...", "correlation": {"key": "expression"}}`;
   it fires when a matching message arrives (POST /api/messages/), never by itself.
 
+And the document itself may carry `"data"`: a JSON object every case's data
+starts with (the use case's settings: poses, spots, task lists); the data a
+case is started with is laid over it, key by key.
+
 Configuration values are literals or expressions (a string starting with "=",
 see expressions.py), resolved against the case data when the task starts.
 """
@@ -45,6 +49,11 @@ DEVICE_CALLS: Final[Mapping[str, tuple[str, tuple[str, ...], tuple[str, ...]]]] 
     "part-detection.scan": ("Devices/PartDetection/Scan", (), ("detected", "pose")),
     "inspection.inspect": ("Devices/Inspection/Inspect", ("spot",), ("result",)),
     "display.show": ("Devices/Display/Show", ("text",), ()),
+    "recognition.gesture": ("Devices/Recognition/Gesture", ("gesture",), ("detected",)),
+    "recognition.face": ("Devices/Recognition/Face", (), ("authorized",)),
+    "recognition.screws": ("Devices/Recognition/Screws", ("expected",), ("found",)),
+    "place-position.check": ("Devices/PlacePosition/Check", (), ("free",)),
+    "place-position.wait": ("Devices/PlacePosition/WaitUntilFree", ("timeout_ms",), ("free",)),
 }
 
 # How a space constraint interrupts the cobot (its "interrupt" key); pause by default.
@@ -260,9 +269,24 @@ def message_of(transition: Transition) -> MessageConfig | None:
     return MessageConfig(raw["name"], correlation)
 
 
+def initial_data(pattern: Pattern) -> dict[str, Any]:
+    """The data every case of the pattern starts with: its `data` object, {} without one.
+
+    Raises ConfigError (naming "data") when it is not a JSON object.
+    """
+    raw = pattern.extra.get("data", {})
+    if not isinstance(raw, Mapping) or not all(isinstance(key, str) for key in raw):
+        raise ConfigError("data", "the pattern's 'data', what each case starts with, must be a JSON object.")  # fmt: skip
+    return dict(raw)
+
+
 def config_issues(pattern: Pattern) -> list[Issue]:
     """Every malformed task, guard or message configuration, as `task-config` errors."""
     issues = []
+    try:
+        initial_data(pattern)
+    except ConfigError as problem:
+        issues.append(error("task-config", str(problem)))
     for _, transition in pattern.transitions():
         try:
             if transition.is_task:

@@ -5,7 +5,7 @@ from typing import Any
 import pytest
 
 from hrc.engine import check_document, read_pattern
-from hrc.engine.runtime import resolve
+from hrc.engine.runtime import CaseNet, resolve
 from hrc.engine.taskconfig import (
     DEFAULT_PROGRAM,
     DEFAULT_RETRIES,
@@ -15,6 +15,7 @@ from hrc.engine.taskconfig import (
     TaskConfig,
     config_issues,
     guard_of,
+    initial_data,
     message_of,
     task_config,
 )
@@ -477,3 +478,35 @@ def test_check_document_reports_a_malformed_device_call_instead_of_failing() -> 
     report = check_document(data)
 
     assert [(e.code, e.elements) for e in report.errors] == [("task-config", ("tc2",))]
+
+
+# The pattern's initial case data ------------------------------------------------------------
+
+
+def test_a_pattern_without_data_starts_its_cases_empty() -> None:
+    assert initial_data(read_pattern(_doc())) == {}
+
+
+def test_the_patterns_data_is_what_each_case_starts_with_a_copy_each_time() -> None:
+    data = _doc()
+    data["data"] = {"spots": [[0.1, 0.2, 0.0, 0, 0, 0]], "done": []}
+    net = CaseNet(read_pattern(data))
+
+    first = net.initial_data()
+    first["done"].append("x")
+
+    assert net.initial_data() == {"spots": [[0.1, 0.2, 0.0, 0, 0, 0]], "done": []}
+    assert config_issues(read_pattern(data)) == []
+
+
+@pytest.mark.parametrize("value", [[1, 2], "spots", 3, None])
+def test_data_that_is_no_json_object_is_a_task_config_error(value: object) -> None:
+    data = _doc()
+    data["data"] = value
+
+    with pytest.raises(ConfigError, match="must be a JSON object"):
+        initial_data(read_pattern(data))
+    [issue] = config_issues(read_pattern(data))
+    assert issue.code == "task-config"
+    assert "'data'" in issue.message
+    assert not check_document(data).valid

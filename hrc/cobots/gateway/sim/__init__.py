@@ -8,6 +8,7 @@
 - `fencing.py`: the step request and the execution log that makes redelivery harmless.
 - `registers.py`: the input and output register file.
 - `devices.py`: linear axis, part detection, inspection system, display.
+- `sensors.py`: the use cases' recognition camera (gestures, face, screws) and place position.
 - `faults.py`: the hang and slowdown faults injected into steps.
 - `state.py`: the saved controller state (atomic JSON file).
 - `clock.py`, `publisher.py`: scaled time; publishing only what changed.

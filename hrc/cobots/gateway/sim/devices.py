@@ -4,7 +4,9 @@ They replace the prototype client service's simulations (§2.2: /linaxis,
 /partdetectionsystem, /inspectionsystem, /notification), which popped up
 terminals on the service host. Each takes the time the prototype's did
 (scaled), and each random result can be fixed for the next call through a
-writable NextResult, so a test or a demo decides what the device sees.
+writable NextResult, so a test or a demo decides what the device sees. The
+use cases' other sensors (recognition, the place position) are in
+sensors.py and come along with these.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from typing import Any, Final
 from hrc.cobots.gateway.backend import CommandFailed, GatewaySpace, Value
 from hrc.cobots.gateway.sim.clock import Clock
 from hrc.cobots.gateway.sim.publisher import Publisher
+from hrc.cobots.gateway.sim.sensors import Sensors
 
 AXIS_POSITION: Final = "Devices/LinearAxis/Position"
 PART_NEXT: Final = "Devices/PartDetection/NextResult"
@@ -31,15 +34,18 @@ MAX_AXIS_MOVE_MS: Final = 600_000  # ten minutes: anything longer is a typo
 # somewhere in the part box (m).
 DETECTION_PROBABILITY: Final = 2 / 3
 PART_BOX: Final = ((0.0, 0.4), (0.0, 0.5), (0.0, 0.1))
-# The prototype drew OK / NOK / RECHECK evenly; a defect is one of three.
+# The prototype drew OK / NOK / RECHECK evenly: a defect is one of three, and
+# one in three the camera cannot decide ("unsure": a person looks again).
 DEFECT_PROBABILITY: Final = 1 / 3
-INSPECTION_RESULTS: Final = ("ok", "defect")
+UNSURE_PROBABILITY: Final = 1 / 3
+INSPECTION_RESULTS: Final = ("ok", "defect", "unsure")
 
 _BAD_ARGUMENT: Final = "BadInvalidArgument"
 
 
 class Devices:
-    """Linear axis, part detection, inspection system and display; `persist` saves their state."""
+    """Linear axis, part detection, inspection system, display and the sensors (sensors.py);
+    `persist` saves their state."""
 
     def __init__(
         self,
@@ -57,6 +63,7 @@ class Devices:
         self.inspection_next = ""
         self.display_text = ""
         self._axis_lock = asyncio.Lock()
+        self.sensors = Sensors(clock, publish, rng, persist)
 
     async def add_nodes(self, space: GatewaySpace) -> None:
         await space.add_method(
@@ -74,8 +81,10 @@ class Devices:
             "Devices/Inspection/Inspect", self.inspect, [("spot", "Int32")], [("Result", "String")]
         )
         await space.add_method("Devices/Display/Show", self.show, [("text", "String")])
+        await self.sensors.add_nodes(space)
+        writable = (PART_NEXT, INSPECTION_NEXT, *self.sensors.writable)
         for path, value in self.published_values().items():
-            await space.add_variable(path, value, writable=path in (PART_NEXT, INSPECTION_NEXT))
+            await space.add_variable(path, value, writable=path in writable)
 
     def published_values(self) -> dict[str, Value]:
         return {
@@ -83,6 +92,7 @@ class Devices:
             PART_NEXT: self.part_next,
             INSPECTION_NEXT: self.inspection_next,
             DISPLAY_TEXT: self.display_text,
+            **self.sensors.published_values(),
         }
 
     async def move_axis(self, direction: str, duration_ms: int) -> list[Value]:
@@ -123,7 +133,7 @@ class Devices:
         return [True, [round(x, 4), round(y, 4), round(z, 4), 0.0, 0.0, 0.0]]
 
     async def inspect(self, spot: int) -> list[Value]:
-        """Result "ok" or "defect" for the inspected `spot`."""
+        """Result "ok", "defect" or "unsure" (the camera cannot tell) for the inspected `spot`."""
         if spot < 0:
             raise CommandFailed(f"spot must be 0 or more, not {spot}.", _BAD_ARGUMENT)
         await self._clock.sleep(INSPECT_SECONDS)
@@ -131,7 +141,10 @@ class Devices:
         await self._publish({INSPECTION_NEXT: ""})
         if fixed:
             return [fixed]
-        return ["defect" if self._rng.random() < DEFECT_PROBABILITY else "ok"]
+        draw = self._rng.random()
+        if draw < DEFECT_PROBABILITY:
+            return ["defect"]
+        return ["unsure" if draw < DEFECT_PROBABILITY + UNSURE_PROBABILITY else "ok"]
 
     async def show(self, text: str) -> list[Value]:
         """Shows `text` on the cobot's display (the prototype's "cobot head")."""
@@ -143,7 +156,7 @@ class Devices:
     async def write_variable(self, path: str, value: Value) -> bool:
         """Takes a client's write to a NextResult; False if `path` is not the devices'."""
         if path not in (PART_NEXT, INSPECTION_NEXT):
-            return False
+            return await self.sensors.write_variable(path, value)
         if not isinstance(value, str):
             raise CommandFailed(f"{path} holds a String.", "BadTypeMismatch")
         text = value.strip()
@@ -154,7 +167,8 @@ class Devices:
         else:
             if text not in ("", *INSPECTION_RESULTS):
                 raise CommandFailed(
-                    f"{path} must be 'ok', 'defect' or '' (random), not {value!r}.", _BAD_ARGUMENT
+                    f"{path} must be 'ok', 'defect', 'unsure' or '' (random), not {value!r}.",
+                    _BAD_ARGUMENT,
                 )
             self.inspection_next = text
         await self._publish({path: text})
@@ -167,6 +181,7 @@ class Devices:
             "part_next": self.part_next,
             "inspection_next": self.inspection_next,
             "display_text": self.display_text,
+            "sensors": self.sensors.to_dict(),
         }
 
     def restore(self, data: Mapping[str, Any]) -> None:
@@ -184,6 +199,7 @@ class Devices:
             raise ValueError(f"an inspection result {inspection_next!r}")
         self.axis_position, self.part_next, self.inspection_next = axis, part_next, inspection_next
         self.display_text = str(data["display_text"])
+        self.sensors.restore(data.get("sensors", {}))  # absent from states saved before them
 
 
 def _parse_pose(text: str) -> list[float]:

@@ -72,11 +72,13 @@ async def test_the_next_scan_result_can_be_fixed_once(cell: Cell) -> None:
     assert refused.value.status == "BadInvalidArgument"
 
 
-async def test_inspection_says_ok_or_defect_and_can_be_fixed() -> None:
+async def test_inspection_says_ok_defect_or_unsure_and_can_be_fixed() -> None:
     cell = await Cell.start(time_scale=0)
     try:
-        results = {(await cell.space.call("Devices/Inspection/Inspect", 3))[0] for _ in range(20)}
-        assert results == {"ok", "defect"}
+        results = {(await cell.space.call("Devices/Inspection/Inspect", 3))[0] for _ in range(30)}
+        assert results == {"ok", "defect", "unsure"}
+        await cell.backend.write_variable("Devices/Inspection/NextResult", "unsure")
+        assert await cell.space.call("Devices/Inspection/Inspect", 2) == ["unsure"]
         await cell.backend.write_variable("Devices/Inspection/NextResult", "defect")
         assert await cell.space.call("Devices/Inspection/Inspect", 1) == ["defect"]
         with pytest.raises(CommandFailed) as refused:
