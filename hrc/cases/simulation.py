@@ -7,6 +7,25 @@ cobot actor; the pattern published there; N cases started; every operator
 task started as soon as it is offered and completed after a short random
 delay. Jobs run either on this process's threads (`inline`) or on Celery
 workers started elsewhere.
+
+What a simulated operator enters in a form (`example_for`): for each
+required field, the field's `examples` in turn (the n-th time the operator
+completes that task in a case it answers examples[n mod len], so a fixture's
+`"examples": ["top right", "bottom left", …]` is the order that operator
+mounts in), else its `default`, else its first `enum` value, else a value of
+its type.
+
+A document may say how its cases differ from each other (the extended spot
+taping: one case per operator, the second with the other workspace and the
+cobots swapped) under `"simulation": {"cases": [...]}`; case i of a run is
+`cases[i mod len]`:
+
+    {"name": "operator 2", "data": {"workspace": 1},
+     "actors": {"o": "o2", "cL": "cR", "cR": "cL"}}
+
+`data` is laid over the pattern's data; `actors` says who stands in for an
+actor in that case: another actor of the same type (the cobots swapped), or
+a new name, which gets a simulated operator or cobot of its own.
 """
 
 from __future__ import annotations
@@ -14,9 +33,11 @@ from __future__ import annotations
 import contextlib
 import datetime as dt
 import random
+import re
 import threading
 import time
 import uuid
+from collections import Counter
 from collections.abc import Iterator, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -73,6 +94,46 @@ class RunEvent:
         }
 
 
+@dataclass(frozen=True)
+class CaseVariant:
+    """How one case of a run differs from the version's defaults (`"simulation": {"cases"}`)."""
+
+    name: str
+    data: Mapping[str, Any]
+    actors: Mapping[str, str]  # pattern actor → who stands in for it
+
+
+_STAND_IN = re.compile(r"[A-Za-z0-9_-]{1,40}")
+
+
+def case_variants(document: Mapping[str, Any], pattern: Pattern) -> list[CaseVariant]:
+    """The document's `"simulation": {"cases": [...]}`; raises ValueError saying what is wrong."""
+    simulation = document.get("simulation", {})
+    cases = simulation.get("cases", []) if isinstance(simulation, Mapping) else None
+    if not isinstance(cases, list):
+        raise ValueError('"simulation" must be an object whose "cases" is a list.')
+    types = {actor.id: actor.type for actor in pattern.actors}
+    variants = []
+    for index, case in enumerate(cases, start=1):
+        where = f"simulation case {index}"
+        if not isinstance(case, Mapping):
+            raise ValueError(f"{where} must be an object.")
+        data, actors = case.get("data", {}), case.get("actors", {})
+        if not isinstance(data, Mapping):
+            raise ValueError(f"{where}: its data must be an object.")
+        if not isinstance(actors, Mapping):
+            raise ValueError(f"{where}: its actors must map actors to stand-ins.")
+        for actor, stand_in in actors.items():
+            if actor not in types:
+                raise ValueError(f"{where}: the pattern has no actor {actor!r}.")
+            if not isinstance(stand_in, str) or not _STAND_IN.fullmatch(stand_in):
+                raise ValueError(f"{where}: {actor}'s stand-in must be a name of letters, digits, - or _.")  # fmt: skip
+            if types.get(stand_in, types[actor]) != types[actor]:
+                raise ValueError(f"{where}: {actor} and {stand_in} are not both {types[actor]}s.")
+        variants.append(CaseVariant(str(case.get("name") or where), dict(data), dict(actors)))
+    return variants
+
+
 @dataclass
 class Simulation:
     """One run: set up, run cases, report; use as a context manager so gateways stop."""
@@ -94,6 +155,10 @@ class Simulation:
         self._threads: list[threading.Thread] = []
         self._pool: ThreadPoolExecutor | None = None
         self._cobot_names: dict[str, str] = {}
+        self._cobots: dict[str, Cobot] = {}
+        self._variants: list[CaseVariant] = []
+        self._started = 0
+        self._answers: Counter[tuple[int, str]] = Counter()
 
     # Set-up ---------------------------------------------------------------------------
 
@@ -122,26 +187,37 @@ class Simulation:
         )
         self.version = pattern_services.publish_pattern(pattern, published_by=engineer)
         net = case_net(self.version)
-        mapping: dict[str, Any] = {}
-        for actor in net.pattern.actors:
-            if actor.type == "operator":
-                self.users[actor.id] = self._member(f"rp-{suffix}-{actor.id}", Role.OPERATOR)
-                mapping[actor.id] = {"users": [self.users[actor.id].pk]}
+        self._variants = case_variants(self.document, net.pattern)
+        stand_ins = {actor.id: actor.id for actor in net.pattern.actors}
+        for variant in self._variants:
+            # A new name stands in like the first actor it stands in for (its program).
+            stand_ins |= {
+                name: actor for actor, name in variant.actors.items() if name not in stand_ins
+            }
+        types = {actor.id: actor.type for actor in net.pattern.actors}
+        for name, actor in stand_ins.items():
+            if types[actor] == "operator":
+                self.users[name] = self._member(f"rp-{suffix}-{name}", Role.OPERATOR)
             else:
-                mapping[actor.id] = {"cobot": self._simulated_cobot(actor.id, net.pattern).pk}
+                self._cobots[name] = self._simulated_cobot(name, _program_of(net.pattern, actor))
+        mapping = {actor.id: self._binding(actor.id) for actor in net.pattern.actors}
         services.set_default_actor_mapping(self.version, mapping)
+
+    def _binding(self, stand_in: str) -> dict[str, Any]:
+        if stand_in in self.users:
+            return {"users": [self.users[stand_in].pk]}
+        return {"cobot": self._cobots[stand_in].pk}
 
     def _member(self, username: str, role: str) -> User:
         user = User.objects.create_user(username)
         Membership.objects.create(user=user, organisation=self.organisation, role=role)
         return user
 
-    def _simulated_cobot(self, actor: str, pattern: Pattern) -> Cobot:
+    def _simulated_cobot(self, actor: str, program: str) -> Cobot:
         name = f"{actor}-{self.organisation.slug}"
         gateway = GatewayProcess(name, self.workdir / f"{name}.json", time_scale=self.time_scale)
         self.gateways[actor] = gateway.start()
         self._cobot_names[actor] = name
-        program = _program_of(pattern, actor)
         driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
         driver.call("PowerOn", timeout=30)
         driver.call("SelectProgram", program)
@@ -151,7 +227,8 @@ class Simulation:
         )
 
     def cobot(self, actor: str) -> SyncDriver:
-        """A driver to the actor's simulated cobot, to look at it or to play the person at the cell."""
+        """A driver to the actor's simulated cobot (or a stand-in's, by its name), to look at it
+        or to play the person at the cell."""
         return driver_for(self._cobot_names[actor], self.gateways[actor].endpoint)
 
     def executed_steps(self, actor: str) -> tuple[int, list[str]]:
@@ -183,7 +260,21 @@ class Simulation:
         return self.events(started)
 
     def start_cases(self, count: int) -> list[int]:
-        return [services.start_case(self.version, started_by=None).pk for _ in range(count)]
+        """Starts `count` cases; with case variants, each takes the next variant in turn."""
+        started = []
+        for _ in range(count):
+            mapping: dict[str, Any] = {}
+            data: Mapping[str, Any] = {}
+            if self._variants:
+                variant = self._variants[self._started % len(self._variants)]
+                mapping = {actor: self._binding(name) for actor, name in variant.actors.items()}
+                data = variant.data
+            case = services.start_case(
+                self.version, started_by=None, actor_mapping=mapping, data=data
+            )
+            started.append(case.pk)
+            self._started += 1
+        return started
 
     @contextlib.contextmanager
     def running(self, *, operators: bool = True) -> Iterator[None]:
@@ -259,7 +350,9 @@ class Simulation:
                     due[item.pk] = now + self._random.uniform(low, high) * self.time_scale
                 elif now >= due.setdefault(item.pk, now):
                     form = case_net(item.case.version).tasks[item.task].form
-                    services.complete_work_item(item, user=user, data=example_for(form))
+                    answer = self._answers[(item.case_id, item.task)]
+                    services.complete_work_item(item, user=user, data=example_for(form, answer))
+                    self._answers[(item.case_id, item.task)] += 1
 
     # Reporting ------------------------------------------------------------------------
 
@@ -293,18 +386,23 @@ def _program_of(pattern: Pattern, actor: str) -> str:
     return program if isinstance(program, str) and program else DEFAULT_PROGRAM
 
 
-def example_for(schema: Mapping[str, Any] | None) -> dict[str, Any]:
-    """Form data a simulated operator enters: a value of the right type for each required field."""
+def example_for(schema: Mapping[str, Any] | None, answer: int = 0) -> dict[str, Any]:
+    """Form data a simulated operator enters the `answer`-th time (from 0) it completes a task:
+    for each required field its examples in turn, else its default, first choice or a value
+    of its type (the module's docstring)."""
     if not schema:
         return {}
     values: dict[str, Any] = {}
     properties = schema.get("properties", {})
     for name in schema.get("required", []):
-        values[name] = _example_value(properties.get(name, {}))
+        values[name] = _example_value(properties.get(name, {}), answer)
     return values
 
 
-def _example_value(schema: Mapping[str, Any]) -> Any:
+def _example_value(schema: Mapping[str, Any], answer: int) -> Any:
+    examples = schema.get("examples")
+    if isinstance(examples, list) and examples:
+        return examples[answer % len(examples)]
     if "enum" in schema:
         return schema["enum"][0]
     if "default" in schema:
@@ -317,5 +415,5 @@ def _example_value(schema: Mapping[str, Any]) -> Any:
     if kind == "array":
         return []
     if kind == "object":
-        return example_for(schema)
+        return example_for(schema, answer)
     return "ok"

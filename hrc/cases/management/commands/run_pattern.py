@@ -4,6 +4,8 @@ Runs a pattern file end to end against simulated cobots (one OPC UA gateway
 process per cobot actor) with operators that complete their tasks by
 themselves, and prints one JSON event per line:
 {"seq", "at", "case", "task", "actor", "event"}. Exits 0 when every case completed.
+How simulated operators fill forms, and how a document's cases may differ
+(`"simulation": {"cases": [...]}`), is in hrc/cases/simulation.py.
 """
 
 from __future__ import annotations
@@ -15,9 +17,9 @@ from typing import Any
 
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
-from hrc.cases.simulation import Simulation
+from hrc.cases.simulation import Simulation, case_variants
 from hrc.engine.check import check_document
-from hrc.engine.document import FormatError, parse_json
+from hrc.engine.document import FormatError, parse_json, read_pattern
 
 
 class Command(BaseCommand):
@@ -78,4 +80,8 @@ class Command(BaseCommand):
         if not report.valid or not isinstance(data, dict):
             problems = "; ".join(f"{issue.code}: {issue.message}" for issue in report.errors)
             raise CommandError(f"{path} cannot run: {problems}")
+        try:
+            case_variants(data, read_pattern(data))
+        except ValueError as error:
+            raise CommandError(f"{path} cannot run: {error}") from None
         return data
