@@ -16,6 +16,7 @@ without being held in memory. The rows come from hrc.analytics.selectors.
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -175,11 +176,19 @@ def write_log(
 
 
 def _attribute(key: str, value: Value, indent: int) -> str:
-    return f"{' ' * indent}<{_type(value)} key={_quote(key)} value={_quote(_text(value))}/>\n"
+    # The hot loop of a large export: a type lookup, keys quoted once, plain text unescaped.
+    kind = _TAGS.get(type(value)) or _tag(value)
+    text = value if kind == "string" else _text(value)
+    return f"{_INDENT[indent]}<{kind} key={_quoted_key(key)} value={_quote(str(text))}/>\n"
 
 
-def _type(value: Value) -> str:
-    if isinstance(value, bool):  # before int: a bool is an int to Python
+_TAGS = {bool: "boolean", int: "int", float: "float", str: "string", dt.datetime: "date"}
+_INDENT = {n: " " * n for n in (2, 4, 6)}
+
+
+def _tag(value: Value) -> str:
+    """The element of a value whose type is a subclass (a bool is an int to Python)."""
+    if isinstance(value, bool):
         return "boolean"
     if isinstance(value, int):
         return "int"
@@ -198,6 +207,11 @@ def _text(value: Value) -> str:
     return str(value)
 
 
+@functools.lru_cache(maxsize=256)
+def _quoted_key(key: str) -> str:
+    return _quote(key)
+
+
 def timestamp(moment: dt.datetime) -> str:
     """xs:dateTime in UTC with milliseconds: 2025-03-01T09:30:00.250+00:00."""
     if moment.tzinfo is None:
@@ -211,8 +225,12 @@ _ESCAPES = {"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;"}
 # Line breaks and tabs in an attribute value would be read back as spaces unless escaped.
 _ESCAPES |= {"\n": "&#10;", "\r": "&#13;", "\t": "&#9;"}
 _TO_ESCAPE = re.compile('[&<>"\n\r\t]')
+# Either of the above: most text has none and goes out as it is.
+_SPECIAL = re.compile(_NOT_XML.pattern[:-1] + '&<>"\n\r\t]')
 
 
 def _quote(text: str) -> str:
+    if _SPECIAL.search(text) is None:
+        return f'"{text}"'
     clean = _NOT_XML.sub("\ufffd", text)
     return '"' + _TO_ESCAPE.sub(lambda m: _ESCAPES[m.group()], clean) + '"'
