@@ -10,6 +10,7 @@ and say what is wrong; outsiders and operators are kept out.
 
 import json
 import re
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -93,6 +94,17 @@ def _box(page: Page, element_id: str) -> FloatRect:
 def _centre(page: Page, element_id: str) -> tuple[float, float]:
     box = _box(page, element_id)
     return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+
+
+def _near(box: FloatRect, other: FloatRect) -> bool:
+    return abs(box["x"] - other["x"]) < 2 and abs(box["y"] - other["y"]) < 2
+
+
+def _until(condition: Callable[[], bool], timeout: float = 15.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "condition not reached in time"
+        time.sleep(0.05)
 
 
 def _click(page: Page, element_id: str) -> None:
@@ -520,3 +532,150 @@ def test_an_operator_may_read_the_list_but_not_edit(
     expect(page.get_by_role("alert")).to_contain_text("Only engineers and admins")
     expect(page.locator("#hrc-editor")).to_have_count(0)
     screenshot(page, "editor-operator-refused")
+
+
+def test_a_dragged_node_is_laid_out_again_and_undo_brings_it_back(
+    page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    laid_out = _box(page, "p3")
+    x, y = _centre(page, "p3")
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + 30, y + 25, steps=8)
+    page.mouse.up()
+    dragged = _box(page, "p3")
+    assert dragged["x"] > laid_out["x"] + 20
+    assert dragged["y"] > laid_out["y"] + 15
+
+    page.get_by_role("button", name="Layout").click()
+    _until(lambda: _near(_box(page, "p3"), laid_out))
+    # One undo takes the whole layout back; a second one the drag.
+    page.keyboard.press("Control+z")
+    assert _near(_box(page, "p3"), dragged)
+    page.keyboard.press("Control+z")
+    assert _near(_box(page, "p3"), laid_out)
+    page.keyboard.press("Control+y")
+    assert _near(_box(page, "p3"), dragged)
+
+
+def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    panel = page.get_by_role("region", name="Properties")
+
+    def commit(label: str, value: str) -> None:
+        field = panel.get_by_label(label, exact=True)
+        field.fill(value)
+        field.press("Tab")
+
+    _click(page, "tc2")
+    expect(panel.get_by_role("heading", name="Cobot task")).to_be_visible()
+    commit("Instructions", "Place the insert in the fixture.")
+    panel.get_by_label("Program", exact=True).fill("Assembly")
+    panel.get_by_label("Program", exact=True).press("Tab")
+    commit("Step number", "4")
+    commit("Workspace", "=data.station")
+    commit("Pose list", "0.1, 0.2, 0.05, 0, 3.14, 0\n=data.insert_pose")
+    commit("Step number", "-2")
+    expect(
+        panel.get_by_role("alert").filter(
+            has_text="The step's number must be a whole number ≥ 0 or an expression starting with ="
+        )
+    ).to_be_visible()
+    screenshot(page, "editor-properties-cobot-task")
+
+    _click(page, "tc3")
+    panel.get_by_label("Runs").select_option("device")
+    panel.get_by_label("Device call").select_option("display.show")
+    commit("Argument text", "=data.message")
+
+    _click(page, "to2")
+    expect(panel.get_by_role("heading", name="Operator task")).to_be_visible()
+    panel.get_by_role("button", name="Add a form field").click()
+    commit("Name", "insert_ok")
+    commit("Title", "Insert seated")
+    panel.get_by_label("Type").select_option("boolean")
+    panel.get_by_label("required").check()
+
+    _click(page, "p1")
+    commit("Label", "workpiece arrives")
+    page.get_by_role("button", name="Save", exact=True).click()
+    expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text("Saved.", timeout=CHECKED)
+
+    pattern.refresh_from_db()
+    transitions = {t["id"]: t for t in pattern.draft["processes"][0]["transitions"]}
+    assert transitions["tc2"]["task"] == {
+        "instructions": "Place the insert in the fixture.",
+        "step": {
+            "number": 4,
+            "workspace": "=data.station",
+            "poses": [[0.1, 0.2, 0.05, 0, 3.14, 0], "=data.insert_pose"],
+            "program": "Assembly",
+        },
+    }
+    assert transitions["tc3"]["task"] == {
+        "device": {"call": "display.show", "args": {"text": "=data.message"}}
+    }
+    assert transitions["to2"]["task"]["form"] == {
+        "type": "object",
+        "properties": {"insert_ok": {"type": "boolean", "title": "Insert seated"}},
+        "required": ["insert_ok"],
+    }
+    places = {p["id"]: p for p in pattern.draft["processes"][0]["places"]}
+    assert places["p1"]["label"] == "workpiece arrives"
+    # What the editor does not know travels unchanged.
+    assert pattern.draft["source"] == "thesis, section 4.3.1, CP_synch_1O1C"
+    # The server checks the configuration as part of the model.
+    expect(_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+
+
+def test_keys_select_copy_paste_delete_and_undo(
+    page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    shapes = page.locator(".djs-shape")
+    count = shapes.count()
+
+    lane = _box(page, "o")
+    page.mouse.click(lane["x"] + 10, lane["y"] + lane["height"] / 2)  # on the lane's header
+    page.keyboard.press("Delete")
+    expect(page.locator(".hrc-refusal")).to_have_text(
+        "The lane of o still holds tasks to1, to2: delete them or move them to another lane first."
+    )
+    expect(shapes).to_have_count(count)
+
+    _click(page, "tc1")
+    page.keyboard.press("Control+c")
+    page.keyboard.press("Control+v")
+    lane = _box(page, "c")
+    # Free space at the end of the cobot's lane: the copy stays the cobot's.
+    x, y = lane["x"] + lane["width"] - 30, lane["y"] + lane["height"] / 2
+    page.mouse.move(x, y, steps=6)
+    page.mouse.down()
+    page.mouse.up()
+    expect(shapes).to_have_count(count + 1)
+    expect(page.locator('.djs-shape[data-element-id="tc4"]')).to_contain_text("pick insert")
+
+    page.keyboard.press("Delete")
+    expect(shapes).to_have_count(count)
+    page.keyboard.press("Control+z")
+    expect(shapes).to_have_count(count + 1)
+    page.keyboard.press("Control+z")
+    expect(shapes).to_have_count(count)
+    page.keyboard.press("Control+a")
+    expect(page.locator(".djs-element.selected")).to_have_count(
+        page.locator(".djs-shape, .djs-connection").count() - 2  # not the two lanes
+    )

@@ -43,7 +43,11 @@ export default class Toolbar {
       node.type = "button";
       node.textContent = text;
       node.title = title;
-      node.addEventListener("click", () => void run());
+      node.addEventListener("click", () => {
+        void run();
+        // Back to the drawing, so its keys (Ctrl+Z, Delete, A…) work right after.
+        canvas.focus();
+      });
       bar.appendChild(node);
       return node;
     };

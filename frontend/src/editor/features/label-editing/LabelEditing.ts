@@ -24,9 +24,10 @@ export default class LabelEditing {
     eventBus.on("element.dblclick", (event: { element: Shape }) => {
       if (isNode(event.element) || isLane(event.element)) this.activate(event.element);
     });
-    eventBus.on("create.end", 500, (event: { context: { shape?: Shape } }) => {
-      const shape = event.context.shape;
-      if (shape && isTask(shape)) setTimeout(() => this.activate(shape));
+    // A task taken from the palette asks for its label at once (not a pasted one: it has one).
+    eventBus.on("create.end", 500, (event: { context: { shape?: Shape; canExecute?: unknown; hints?: { editLabel?: boolean } } }) => {
+      const { shape, canExecute, hints } = event.context;
+      if (shape && canExecute && hints?.editLabel && isTask(shape)) setTimeout(() => this.activate(shape));
     });
     eventBus.on(["diagram.clear", "canvas.viewbox.changing", "drag.init"], () => this.finish(true));
   }

@@ -50,7 +50,7 @@ export default class PaletteProvider {
     const start = (event: Event) => {
       const object = structuredClone(template);
       const shape = this.elementFactory.createShape({ businessObject: object });
-      this.create.start(event, shape);
+      this.create.start(event, shape, { hints: { editLabel: true } });
     };
     return { group: "nodes", title, html: entryHtml(icon), action: { click: start, dragstart: start } };
   }

@@ -11,25 +11,45 @@ export interface FieldOptions {
   type?: string;
 }
 
+let fieldCount = 0;
+
+/** A labelled control; the hint and the error describe it without being part of its name. */
+function labelled(parent: HTMLElement, text: string, control: HTMLElement, hint?: string): HTMLElement {
+  fieldCount += 1;
+  const id = `hrc-field-${fieldCount}`;
+  const wrapper = add(parent, "div", "hrc-field");
+  const label = add(wrapper, "label", "hrc-field-label") as HTMLLabelElement;
+  label.htmlFor = id;
+  label.textContent = text;
+  control.id = id;
+  wrapper.appendChild(control);
+  const described: string[] = [];
+  if (hint) {
+    const small = add(wrapper, "small", "hrc-hint");
+    small.id = `${id}-hint`;
+    small.textContent = hint;
+    described.push(small.id);
+  }
+  const error = add(wrapper, "span", "hrc-field-error");
+  error.id = `${id}-error`;
+  error.setAttribute("role", "alert");
+  described.push(error.id);
+  control.setAttribute("aria-describedby", described.join(" "));
+  return error;
+}
+
 export function field(parent: HTMLElement, options: FieldOptions): HTMLInputElement | HTMLTextAreaElement {
-  const wrapper = add(parent, "label", "hrc-field");
-  add(wrapper, "span", "hrc-field-label").textContent = options.label;
   const input = options.multiline ? document.createElement("textarea") : document.createElement("input");
   if (input instanceof HTMLInputElement) input.type = options.type ?? "text";
   input.value = options.value;
   if (options.placeholder) input.placeholder = options.placeholder;
-  wrapper.appendChild(input);
-  if (options.hint) add(wrapper, "small", "hrc-hint").textContent = options.hint;
-  const error = add(wrapper, "span", "hrc-field-error");
-  error.setAttribute("role", "alert");
+  const error = labelled(parent, options.label, input, options.hint);
   if (!options.commit) input.readOnly = true;
   else input.addEventListener("change", () => run(error, () => options.commit?.(input.value)));
   return input;
 }
 
 export function select(parent: HTMLElement, label: string, value: string, choices: [string, string][], commit?: (value: string) => void): HTMLSelectElement {
-  const wrapper = add(parent, "label", "hrc-field");
-  add(wrapper, "span", "hrc-field-label").textContent = label;
   const input = document.createElement("select");
   for (const [choice, text] of choices) {
     const option = add(input, "option", "") as HTMLOptionElement;
@@ -38,9 +58,7 @@ export function select(parent: HTMLElement, label: string, value: string, choice
   }
   input.value = value;
   input.disabled = !commit;
-  wrapper.appendChild(input);
-  const error = add(wrapper, "span", "hrc-field-error");
-  error.setAttribute("role", "alert");
+  const error = labelled(parent, label, input);
   input.addEventListener("change", () => run(error, () => commit?.(input.value)));
   return input;
 }
