@@ -40,7 +40,7 @@ class Persona:
         """Paths of the pages this persona works in, first the one to open."""
         if self.role == Role.OPERATOR:
             return ("/tablet/",)
-        supervisor = ("/patterns/", "/cases/", "/incidents/")
+        supervisor = ("/patterns/", "/cases/", "/incidents/", "/analytics/")
         return (*supervisor, "/admin/") if self.staff else supervisor
 
 
@@ -59,8 +59,11 @@ class DemoCobot:
     name: str
     port: int
 
-    def endpoint(self, port: int | None = None) -> str:
-        return f"opc.tcp://127.0.0.1:{port or self.port}"
+    def endpoint(
+        self, template: str = "opc.tcp://127.0.0.1:{port}", port: int | None = None
+    ) -> str:
+        """`template` with {cobot}, {COBOT} (upper case) and {port} filled in."""
+        return template.format(cobot=self.name, COBOT=self.name.upper(), port=port or self.port)
 
 
 DEMO_COBOTS = (DemoCobot("cobot1", 4841), DemoCobot("cobot2", 4842))
@@ -83,14 +86,19 @@ def generate_password() -> str:
 
 @transaction.atomic
 def provision(
-    cobot_ports: Mapping[str, int] | None = None, *, keep_passwords: bool = False
+    *,
+    endpoints: Mapping[str, str] | None = None,
+    credentials: Mapping[str, str] | None = None,
+    keep_passwords: bool = False,
 ) -> DemoOrganisation:
     """Makes the demo organisation complete and returns it with the passwords it set.
 
     Every persona gets a new generated password unless `keep_passwords` and
-    the user already has one. Each demo cobot is (re)pointed at its
-    gateway's loopback port (`cobot_ports` by name, else DemoCobot.port),
-    unsecured, active. Safe to call again: nothing is duplicated.
+    the user already has one. Each demo cobot is (re)pointed at its gateway:
+    `endpoints` and `credentials` (a credentials source) by cobot name, by
+    default its loopback port (DemoCobot.port) without security, as `make
+    demo` serves them. Safe to call again: nothing is duplicated. Raises
+    ValidationError for an endpoint or source the cobot model refuses.
     """
     organisation = Organisation.objects.filter(slug=ORGANISATION_SLUG).first()
     if organisation is None:
@@ -106,9 +114,14 @@ def provision(
     team = _ensure_team(
         organisation, [users[p.username] for p in PERSONAS if p.role == Role.OPERATOR]
     )
-    ports = cobot_ports or {}
+    endpoints, credentials = endpoints or {}, credentials or {}
     cobots = [
-        _ensure_cobot(organisation, cobot.name, cobot.endpoint(ports.get(cobot.name)))
+        _ensure_cobot(
+            organisation,
+            cobot.name,
+            endpoints.get(cobot.name) or cobot.endpoint(),
+            credentials.get(cobot.name) or "none",
+        )
         for cobot in DEMO_COBOTS
     ]
     return DemoOrganisation(organisation, users, passwords, team, cobots)
@@ -142,9 +155,9 @@ def _ensure_team(organisation: Organisation, operators: list[User]) -> Team:
     return organisation_services.set_team_members(team, memberships)
 
 
-def _ensure_cobot(organisation: Organisation, name: str, endpoint: str) -> Cobot:
+def _ensure_cobot(organisation: Organisation, name: str, endpoint: str, source: str) -> Cobot:
     """The simulated cobot `name` at `endpoint`, where the demo starts its gateway."""
-    settings = {"driver": DriverKind.SIMULATED, "endpoint": endpoint, "credentials_source": "none"}
+    settings = {"driver": DriverKind.SIMULATED, "endpoint": endpoint, "credentials_source": source}
     cobot = organisation.cobots.filter(name=name).first()
     if cobot is None:
         return cobot_services.create_cobot(organisation, name=name, **settings)

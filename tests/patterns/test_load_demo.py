@@ -159,3 +159,33 @@ def test_a_broken_example_is_reported_and_the_others_still_load(tmp_path: Path) 
     assert PatternVersion.objects.count() == 1
     with pytest.raises(CommandError):
         _load_demo("--examples", str(tmp_path), "--strict")
+
+
+@pytest.mark.django_db
+def test_the_cobots_can_point_at_the_compose_gateways() -> None:
+    """What docker/README.md tells a person to run in the compose set-up."""
+    _load_demo(
+        "--cobot-endpoint", "opc.tcp://gateway-{cobot}:4840",
+        "--cobot-credentials", "env:{COBOT}_CREDENTIALS",
+    )  # fmt: skip
+    cobots = Cobot.objects.filter(organisation__slug="demo-plant")
+    assert sorted(cobots.values_list("name", "endpoint", "credentials_source")) == [
+        ("cobot1", "opc.tcp://gateway-cobot1:4840", "env:COBOT1_CREDENTIALS"),
+        ("cobot2", "opc.tcp://gateway-cobot2:4840", "env:COBOT2_CREDENTIALS"),
+    ]
+    _load_demo()  # and back to make demo's loopback gateways
+    assert sorted(cobots.values_list("endpoint", "credentials_source")) == [
+        ("opc.tcp://127.0.0.1:4841", "none"),
+        ("opc.tcp://127.0.0.1:4842", "none"),
+    ]
+
+
+@pytest.mark.django_db
+def test_a_bad_cobot_template_is_refused_naming_what_is_wrong() -> None:
+    with pytest.raises(CommandError, match="--cobot-endpoint may use"):
+        _load_demo("--cobot-endpoint", "opc.tcp://{host}:4840")
+    with pytest.raises(CommandError, match="OPC UA URL"):
+        _load_demo("--cobot-endpoint", "http://gateway-{cobot}:4840")
+    with pytest.raises(CommandError, match="credentials source"):
+        _load_demo("--cobot-credentials", "secret-password")
+    assert not Organisation.objects.filter(slug="demo-plant").exists()

@@ -32,6 +32,7 @@ PAGES = (
     ("editor", "/patterns/", "engineers, admins"),
     ("supervisor", "/cases/", "engineers, admins"),
     ("incidents", "/incidents/", "engineers, admins"),
+    ("analytics", "/analytics/", "engineers, admins"),
     ("admin", "/admin/", "the admin"),
     ("API", "/api/docs/", "anyone signed in; machines with a token"),
 )
@@ -110,7 +111,10 @@ class Command(BaseCommand):
         self.stdout.flush()
 
     def load(self, plan: Plan, keep_passwords: bool) -> organisation.DemoOrganisation:
-        demo = organisation.provision(plan.cobot_ports, keep_passwords=keep_passwords)
+        endpoints = {
+            cobot.name: cobot.endpoint(port=plan.cobot_ports[cobot.name]) for cobot in DEMO_COBOTS
+        }
+        demo = organisation.provision(endpoints=endpoints, keep_passwords=keep_passwords)
         results = library.load_examples(
             demo.organisation, demo.users["engineer"], library.EXAMPLES_DIR, demo.team, demo.cobots
         )

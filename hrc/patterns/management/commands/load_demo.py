@@ -9,6 +9,7 @@ is published as a new version, and every persona gets a new password
 from pathlib import Path
 from typing import Any
 
+from django.core.exceptions import ValidationError
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
 from hrc.demo import library, organisation
@@ -35,13 +36,41 @@ class Command(BaseCommand):
             "--strict", action="store_true", help="Fail when an example cannot be published."
         )
         parser.add_argument(
+            "--cobot-endpoint",
+            default="opc.tcp://127.0.0.1:{port}",
+            metavar="TEMPLATE",
+            help=(
+                "Where each demo cobot's gateway is: {cobot} is its name, {COBOT} in upper case, "
+                "{port} its demo port (default opc.tcp://127.0.0.1:{port}, as make demo serves "
+                "them; docker/compose.yaml: opc.tcp://gateway-{cobot}:4840)."
+            ),
+        )
+        parser.add_argument(
+            "--cobot-credentials",
+            default="none",
+            metavar="TEMPLATE",
+            help=(
+                "Each demo cobot's credentials source, with the same fields (default none; "
+                "docker/compose.yaml: env:{COBOT}_CREDENTIALS)."
+            ),
+        )
+        parser.add_argument(
             "--keep-passwords",
             action="store_true",
             help="Leave the passwords of demo users who have one (they are not printed).",
         )
 
     def handle(self, *args: Any, **options: Any) -> None:
-        demo = organisation.provision(keep_passwords=options["keep_passwords"])
+        endpoints = _filled(options["cobot_endpoint"], "--cobot-endpoint")
+        credentials = _filled(options["cobot_credentials"], "--cobot-credentials")
+        try:
+            demo = organisation.provision(
+                endpoints=endpoints,
+                credentials=credentials,
+                keep_passwords=options["keep_passwords"],
+            )
+        except ValidationError as error:
+            raise CommandError(f"A demo cobot was refused: {'; '.join(error.messages)}") from None
         folder: Path = options["examples"]
         results = library.load_examples(
             demo.organisation, demo.users["engineer"], folder, demo.team, demo.cobots
@@ -61,3 +90,13 @@ class Command(BaseCommand):
         refused = [loaded.file for loaded in results if loaded.refused is not None]
         if refused and options["strict"]:
             raise CommandError(f"{len(refused)} example(s) could not be published: {refused}")
+
+
+def _filled(template: str, option: str) -> dict[str, str]:
+    """The template filled in for each demo cobot; CommandError naming the option when it cannot be."""
+    try:
+        return {cobot.name: cobot.endpoint(template) for cobot in organisation.DEMO_COBOTS}
+    except (KeyError, IndexError, ValueError) as error:
+        raise CommandError(
+            f"{option} may use {{cobot}}, {{COBOT}} and {{port}} only, not {error}."
+        ) from None
