@@ -194,7 +194,8 @@ def performers(mapping: dict[str, Any]) -> dict[str, str]:
     users: set[int] = set()
     teams: set[int] = set()
     cobots: set[int] = set()
-    for binding in mapping.values():
+    bindings = {actor: b for actor, b in mapping.items() if isinstance(b, dict)}
+    for binding in bindings.values():
         users.update(_ids(binding.get("users")))
         teams.update(_ids([binding.get("team")]))
         cobots.update(_ids([binding.get("cobot")]))
@@ -202,7 +203,7 @@ def performers(mapping: dict[str, Any]) -> dict[str, str]:
     team_names = dict(Team.objects.filter(pk__in=teams).values_list("pk", "name"))
     cobot_names = dict(Cobot.objects.filter(pk__in=cobots).values_list("pk", "name"))
     who = {}
-    for actor, binding in mapping.items():
+    for actor, binding in bindings.items():
         if binding.get("cobot") is not None:
             who[actor] = str(cobot_names.get(binding["cobot"], binding["cobot"]))
         elif binding.get("team") is not None:

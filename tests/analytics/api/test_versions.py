@@ -2,6 +2,8 @@
 
 import pytest
 from django.contrib.auth.models import User
+from django.db import connection
+from django.test.utils import CaptureQueriesContext
 from rest_framework.test import APIClient
 
 from hrc.cases.models import Case
@@ -137,3 +139,24 @@ def test_a_version_without_cases_has_empty_figures(
     body = admin_client.get(url(hand_over)).json()
     assert (body["cases"], body["cycle"]["count"], body["cycle"]["p50"]) == (0, 0, None)
     assert (body["tasks"], body["cobots"], body["recent_cases"]) == ([], [], [])
+
+
+def test_the_figures_cost_the_same_few_queries_however_many_cases(
+    engineer_client: APIClient,
+    hand_over: PatternVersion,
+    engineer: User,
+    operator: User,
+    cobot: Cobot,
+) -> None:
+    def queries() -> int:
+        with CaptureQueriesContext(connection) as captured:
+            assert engineer_client.get(url(hand_over)).status_code == 200
+        return len(captured.captured_queries)
+
+    run_hand_over(hand_over, engineer, operator, cobot)
+    one = queries()
+    for _ in range(3):
+        run_hand_over(hand_over, engineer, operator, cobot)
+    assert queries() == one
+    # The version, the role, then cases, work items, jobs and interruptions: a query each.
+    assert one <= 6, one
