@@ -14,6 +14,7 @@ from django.http import HttpRequest, HttpResponse
 from django.shortcuts import get_object_or_404, render
 from django.views.decorators.csrf import ensure_csrf_cookie
 
+from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import may_write_in, writable_organisations
 from hrc.patterns.selectors import patterns_visible_to
@@ -80,6 +81,11 @@ def _target_organisation(request: HttpRequest) -> Organisation | None:
 
 
 def _editor(request: HttpRequest, config: dict[str, Any], title: str) -> HttpResponse:
+    # The device calls a cobot task can make, with their arguments: the engine's list, so
+    # the properties panel offers exactly what a case can run.
+    config["deviceCalls"] = {
+        name: list(arguments) for name, (_, arguments, _) in DEVICE_CALLS.items()
+    }
     return render(request, "patterns/editor.html", {"config": config, "title": title})
 
 

@@ -19,6 +19,7 @@ import pytest
 from django.contrib.auth.models import User
 from playwright.sync_api import FilePayload, FloatRect, Page, expect
 
+from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
@@ -597,6 +598,8 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
 
     _click(page, "tc3")
     panel.get_by_label("Runs").select_option("device")
+    # The calls offered are the engine's (taskconfig.DEVICE_CALLS), passed by the page.
+    expect(panel.get_by_label("Device call").locator("option")).to_have_count(len(DEVICE_CALLS))
     panel.get_by_label("Device call").select_option("display.show")
     commit("Argument text", "=data.message")
 

@@ -2,11 +2,13 @@
 
 import json
 import re
+from typing import Any
 
 import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
+from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel
 from tests import factories
@@ -20,7 +22,7 @@ def _browser(user: User) -> Client:
     return client
 
 
-def _config(html: str) -> dict[str, object]:
+def _config(html: str) -> dict[str, Any]:
     match = re.search(
         r'<script id="hrc-editor-config" type="application/json">(.*?)</script>', html, re.S
     )
@@ -50,6 +52,10 @@ def test_an_engineer_opens_a_draft_in_the_editor(engineer: User, pattern: Patter
         "latestVersion": None,
     }
     assert "csrftoken" in response.cookies
+    # The device calls the properties panel offers are the engine's.
+    assert config["deviceCalls"] == {
+        name: list(arguments) for name, (_, arguments, _) in DEVICE_CALLS.items()
+    }
 
 
 def test_a_new_pattern_opens_an_empty_editor_for_the_organisation(
@@ -59,6 +65,7 @@ def test_a_new_pattern_opens_an_empty_editor_for_the_organisation(
     assert response.status_code == 200
     config = _config(response.content.decode())
     assert config["draft"] is None
+    assert "recognition.gesture" in config["deviceCalls"]
     assert config["pattern"] == {
         "id": None,
         "name": "New pattern",

@@ -39,6 +39,7 @@ import RulesModule from "./features/rules";
 import TokenGameModule from "./features/token-game";
 import type AutoLayout from "./features/layout/AutoLayout";
 import { hasLayout } from "./model/snapshot";
+import { DEVICE_CALLS } from "./model/taskconfig";
 import type { PatternDocument } from "./model/document";
 
 /** Where the editor's panels go, and what it talks to. */
@@ -51,6 +52,8 @@ export interface EditorOptions {
   pattern: { id: number | null; name: string; canWrite: boolean; organisation?: number };
   /** Check with the server as the model changes (off in the bench's static page). */
   liveChecking?: boolean;
+  /** The device calls a cobot task can make; the server's list when the page gives one. */
+  deviceCalls?: Record<string, string[]>;
 }
 
 export const MODULES = [
@@ -95,6 +98,7 @@ export class PatternEditor {
       api: options.api,
       pattern: options.pattern,
       liveChecking: options.liveChecking ?? true,
+      deviceCalls: options.deviceCalls ?? DEVICE_CALLS,
     } as never);
     this.get<{ on(event: string, callback: () => void): void }>("eventBus").on("editor.fit", () => this.fit());
   }

@@ -15,6 +15,8 @@ export interface PageConfig {
   api?: string;
   draft?: unknown;
   liveChecking?: boolean;
+  /** The engine's device calls and their arguments (hrc/engine/taskconfig.py). */
+  deviceCalls?: Record<string, string[]>;
 }
 
 export async function mount(root: HTMLElement, config: PageConfig): Promise<PatternEditor> {
@@ -25,7 +27,7 @@ export async function mount(root: HTMLElement, config: PageConfig): Promise<Patt
   const body = part(root, "div", "hrc-body");
   const canvas = part(body, "div", "hrc-canvas");
   const side = part(body, "aside", "hrc-side");
-  const editor = new PatternEditor({ canvas, toolbar, side, api: new Api(config.api ?? "/api"), pattern: config.pattern, liveChecking: config.liveChecking });
+  const editor = new PatternEditor({ canvas, toolbar, side, api: new Api(config.api ?? "/api"), pattern: config.pattern, liveChecking: config.liveChecking, deviceCalls: config.deviceCalls });
   const notice = part(root, "p", "hrc-notice");
   notice.setAttribute("role", "alert");
   try {

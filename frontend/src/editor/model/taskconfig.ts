@@ -9,12 +9,20 @@ import { type ActorType, type Extra, isObject } from "./document";
 
 export type TaskKind = "operator" | "step" | "device";
 
-/** Device calls a cobot task can make, with their arguments in order (taskconfig.DEVICE_CALLS). */
+/**
+ * Device calls a cobot task can make, with their arguments in order: the engine's
+ * taskconfig.DEVICE_CALLS as the editor page passes it; this copy serves pages without it.
+ */
 export const DEVICE_CALLS: Record<string, string[]> = {
   "linear-axis.move": ["direction", "duration_ms"],
   "part-detection.scan": [],
   "inspection.inspect": ["spot"],
   "display.show": ["text"],
+  "recognition.gesture": ["gesture"],
+  "recognition.face": [],
+  "recognition.screws": ["expected"],
+  "place-position.check": [],
+  "place-position.wait": ["timeout_ms"],
 };
 export const POSE_LENGTH = 6;
 export const MAX_POSES = 2;

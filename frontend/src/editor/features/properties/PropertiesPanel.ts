@@ -22,7 +22,7 @@ import { taskSection } from "./TaskSection";
 type Element = Shape | Connection;
 
 export default class PropertiesPanel {
-  static $inject = ["eventBus", "config.shell", "selection", "elementRegistry", "canvas", "modeling", "elementFactory"];
+  static $inject = ["eventBus", "config.shell", "selection", "elementRegistry", "canvas", "modeling", "elementFactory", "config.deviceCalls"];
 
   readonly panel: HTMLElement;
 
@@ -34,6 +34,7 @@ export default class PropertiesPanel {
     private readonly canvas: Canvas,
     private readonly modeling: PatternModeling,
     private readonly elementFactory: PatternElementFactory,
+    private readonly deviceCalls: Record<string, string[]>,
   ) {
     this.panel = add(shell.side, "section", "hrc-properties");
     this.panel.setAttribute("aria-label", "Properties");
@@ -101,7 +102,7 @@ export default class PropertiesPanel {
       this.modeling.moveElements([shape], { x: 0, y: Math.round(y) });
     });
     const actor = this.elementRegistry.get(performer);
-    taskSection(this.panel, shape, actor && isLane(actor) ? laneObject(actor).data.type : undefined, this.modeling);
+    taskSection(this.panel, shape, actor && isLane(actor) ? laneObject(actor).data.type : undefined, this.modeling, this.deviceCalls);
   }
 
   private laneSection(shape: Shape): void {

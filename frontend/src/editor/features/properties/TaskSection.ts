@@ -24,7 +24,13 @@ import type { TransitionObject } from "../../core/elements";
 import type PatternModeling from "../modeling/PatternModeling";
 import { add, button, checkbox, field, heading, note, select } from "./fields";
 
-export function taskSection(parent: HTMLElement, shape: Shape, actorType: ActorType | undefined, modeling: PatternModeling): void {
+export function taskSection(
+  parent: HTMLElement,
+  shape: Shape,
+  actorType: ActorType | undefined,
+  modeling: PatternModeling,
+  deviceCalls: Record<string, string[]> = DEVICE_CALLS,
+): void {
   const object = shape.businessObject as TransitionObject;
   const task: Extra = isObject(object.data.task) ? object.data.task : {};
   const set = (next: Extra) => modeling.updateData(shape, { task: Object.keys(next).length ? next : undefined });
@@ -41,7 +47,7 @@ export function taskSection(parent: HTMLElement, shape: Shape, actorType: ActorT
   else {
     select(parent, "Runs", kind, [["step", "a program step"], ["device", "a device call (automated task)"]], (value) => set(withKind(task, value as "step" | "device")));
     if (kind === "step") stepEditor(parent, task, setKey);
-    else deviceEditor(parent, task, setKey);
+    else deviceEditor(parent, task, setKey, deviceCalls);
   }
   field(parent, { label: "Timeout (s)", value: task.timeout === undefined ? "" : String(task.timeout), placeholder: "120", commit: (text) => setKey("timeout", text.trim() ? positive(text, "The timeout") : undefined) });
   if (kind !== "operator") field(parent, { label: "Automatic retries", value: task.retries === undefined ? "" : String(task.retries), placeholder: "3", commit: (text) => setKey("retries", text.trim() ? whole(text, "Retries") : undefined) });
@@ -79,14 +85,14 @@ function stepEditor(parent: HTMLElement, task: Extra, setKey: (key: string, valu
   }
 }
 
-function deviceEditor(parent: HTMLElement, task: Extra, setKey: (key: string, value: unknown) => void): void {
+function deviceEditor(parent: HTMLElement, task: Extra, setKey: (key: string, value: unknown) => void, calls: Record<string, string[]>): void {
   const device: Extra = isObject(task.device) ? task.device : {};
-  const call = typeof device.call === "string" && device.call in DEVICE_CALLS ? device.call : "part-detection.scan";
+  const call = typeof device.call === "string" && device.call in calls ? device.call : Object.keys(calls)[0];
   const args: Extra = isObject(device.args) ? device.args : {};
-  select(parent, "Device call", call, Object.keys(DEVICE_CALLS).map((name) => [name, name]), (value) =>
-    setKey("device", { ...device, call: value, args: Object.fromEntries(DEVICE_CALLS[value].map((name) => [name, args[name] ?? ""])) }),
+  select(parent, "Device call", call, Object.keys(calls).map((name) => [name, name]), (value) =>
+    setKey("device", { ...device, call: value, args: Object.fromEntries(calls[value].map((name) => [name, args[name] ?? ""])) }),
   );
-  for (const name of DEVICE_CALLS[call]) {
+  for (const name of calls[call]) {
     const value = args[name];
     field(parent, {
       label: `Argument ${name}`,
@@ -95,7 +101,7 @@ function deviceEditor(parent: HTMLElement, task: Extra, setKey: (key: string, va
       commit: (text) => setKey("device", { ...device, call, args: { ...args, [name]: literal(text) } }),
     });
   }
-  if (DEVICE_CALLS[call].length === 0) note(parent, `${call} takes no arguments.`);
+  if (calls[call].length === 0) note(parent, `${call} takes no arguments.`);
 }
 
 function formEditor(parent: HTMLElement, task: Extra, setKey: (key: string, value: unknown) => void): void {
