@@ -106,7 +106,6 @@ export default class PatternRenderer extends BaseRenderer {
     const label = svg("text", { x: LANE_HEADER / 2, y: middle, transform: `rotate(-90 ${LANE_HEADER / 2} ${middle})`, "text-anchor": "middle", "dominant-baseline": "middle", "font-size": 12, class: "hrc-text hrc-lane-label" }, parent);
     const name = typeof actor.label === "string" && actor.label ? `${actor.id} · ${actor.label}` : actor.id;
     label.textContent = `${style.word} ${name}`;
-    drawActorGlyph(parent, actor.type === "cobot" ? "cobot" : "operator", LANE_HEADER / 2 - 5, 8, style.stroke);
     return body;
   }
 

@@ -4,7 +4,7 @@
  * their document object in `data`; the shape's id is the document id.
  */
 
-import type { Connection, Shape } from "diagram-js/lib/model/Types";
+import type { Shape } from "diagram-js/lib/model/Types";
 
 import type { ActorData, ConstraintData, Extra, PlaceData, TransitionData } from "../model/document";
 
