@@ -104,6 +104,39 @@ def test_a_port_in_use_is_named_and_nothing_is_started(tmp_path: Path) -> None:
     assert not (tmp_path / "logs").exists()
 
 
+@pytest.mark.parametrize(
+    ("variable", "url", "message"),
+    [
+        (
+            "DATABASE_URL",
+            "postgres://postgres@127.0.0.1:{port}/nothing",
+            "The database does not answer",
+        ),
+        ("REDIS_URL", "redis://127.0.0.1:{port}/0", "REDIS_URL is set but Redis does not answer"),
+    ],
+)
+def test_a_database_or_redis_that_does_not_answer_is_named_and_nothing_is_started(
+    tmp_path: Path, variable: str, url: str, message: str
+) -> None:
+    environment = {
+        **os.environ,
+        "DJANGO_SETTINGS_MODULE": "hrc.settings.dev",
+        "DATABASE_URL": f"sqlite:///{tmp_path / 'demo.sqlite3'}",
+        variable: url.format(port=free_port()),  # nothing listens there
+    }
+    if variable == "DATABASE_URL":
+        environment.pop("REDIS_URL", None)
+    result = subprocess.run(
+        [sys.executable, "manage.py", "demo", "--port", str(free_port()),
+         "--cobot-ports", f"{free_port()},{free_port()}", "--logs", str(tmp_path / "logs")],
+        cwd=ROOT, capture_output=True, text=True, timeout=120, env=environment,
+    )  # fmt: skip
+    assert result.returncode == 1
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not (tmp_path / "logs").exists()
+
+
 def _check_personas(demo: DemoRun) -> None:
     """Each persona signs in with the printed password and finds its first page; walls hold."""
     passwords = demo.passwords()

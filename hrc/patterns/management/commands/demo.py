@@ -19,6 +19,7 @@ import redis
 from django.conf import settings
 from django.core.management import call_command
 from django.core.management.base import BaseCommand, CommandError, CommandParser
+from django.db import OperationalError
 
 from hrc.demo import library, organisation
 from hrc.demo.organisation import DEMO_COBOTS, PERSONAS
@@ -84,8 +85,17 @@ class Command(BaseCommand):
         # SIGINT too, even when started with it ignored (a background job of a script).
         signal.signal(signal.SIGTERM, _interrupt)
         signal.signal(signal.SIGINT, _interrupt)
+        database = settings.DATABASES["default"]
+        if "sqlite" in database["ENGINE"]:  # the embedded default lives in var/, made here
+            Path(database["NAME"]).parent.mkdir(parents=True, exist_ok=True)
         self.say(f"Database: {_database()}; migrating")
-        call_command("migrate", interactive=False, verbosity=0)
+        try:
+            call_command("migrate", interactive=False, verbosity=0)
+        except OperationalError as error:
+            raise CommandError(
+                f"The database does not answer ({error}). Start it, or unset DATABASE_URL to run "
+                "the demo on SQLite under var/."
+            ) from None
         demo_organisation = self.load(plan, options["keep_passwords"])
         demo = Demo(plan)
         failure: DemoFailed | None = None
