@@ -1,9 +1,10 @@
 """Downloads stream on both servers: a plain iterator under WSGI, batches pulled on demand
 under ASGI (Django would otherwise read a synchronous iterator whole before sending)."""
 
+import asyncio
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 
-from asgiref.sync import async_to_sync
 from django.test import AsyncRequestFactory, RequestFactory
 
 from hrc.analytics.streaming import ASYNC_BATCH, streamed
@@ -45,7 +46,9 @@ def test_under_asgi_batches_are_pulled_one_at_a_time() -> None:
         taken_after_first = chunks.taken
         return taken_after_first, first + [part async for part in stream]
 
-    taken_after_first, parts = async_to_sync(first_batch_then_rest)()
+    # On a thread of its own: a browser test's Playwright may have left an event loop on this one.
+    with ThreadPoolExecutor(1) as thread:
+        taken_after_first, parts = thread.submit(asyncio.run, first_batch_then_rest()).result()
     assert taken_after_first == ASYNC_BATCH
     assert len(parts) == 3
     assert b"".join(parts) == "".join(str(n) for n in range(chunks.total)).encode()
