@@ -18,6 +18,7 @@ import signal
 import socket
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -82,6 +83,21 @@ def test_with_database_and_redis_urls_it_runs_a_worker_and_the_monitor_and_sigte
             assert demo.signal(signal.SIGTERM) == 0
         finally:
             demo.stop()
+    _check_everything_ended(demo, children)
+
+
+def test_a_demo_killed_outright_takes_its_processes_with_it(tmp_path: Path) -> None:
+    """SIGKILL leaves the runner no chance to stop anything: the children go by PR_SET_PDEATHSIG."""
+    demo = DemoRun(tmp_path, database_url=f"sqlite:///{tmp_path / 'demo.sqlite3'}").start()
+    try:
+        children = demo.descendants()
+        assert len(children) >= 3
+        assert demo.signal(signal.SIGKILL) == -signal.SIGKILL
+        deadline = time.monotonic() + 30
+        while any(alive(pid) for pid in children) and time.monotonic() < deadline:
+            time.sleep(0.2)
+    finally:
+        demo.stop()
     _check_everything_ended(demo, children)
 
 
