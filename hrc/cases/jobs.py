@@ -102,12 +102,14 @@ def lease_next_job(cobot_id: int) -> Lease | None:
     """
     now = timezone.now()
     with transaction.atomic():
+        # The lock first, then the reasons to wait in a statement of their own: a statement
+        # sees what was committed when it began, so one that waited for the lock would not
+        # see the job the lease before it took (READ COMMITTED; tests/cases/test_cobot_lock.py).
+        Cobot.objects.select_for_update(of=("self",)).filter(pk=cobot_id).exists()
         busy = Job.objects.filter(cobot=OuterRef("pk"), state=JobState.RUNNING)
-        cobot = (
-            Cobot.objects.select_for_update(of=("self",))
-            .annotate(busy=Exists(busy), paused=Exists(_unsettled_interruptions(OuterRef("pk"))))
-            .get(pk=cobot_id)
-        )  # the lock and both reasons to wait in one query
+        cobot = Cobot.objects.annotate(
+            busy=Exists(busy), paused=Exists(_unsettled_interruptions(OuterRef("pk")))
+        ).get(pk=cobot_id)
         if cobot.busy or cobot.paused:
             return None
         if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.live.services)

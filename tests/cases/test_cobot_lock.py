@@ -1,0 +1,111 @@
+"""One cobot, one job at a time, even when two workers reach for the cobot at the same moment.
+
+The second worker's lease waits on the cobot's row lock while the first
+lease commits. Whatever the second reads about the cobot must be read after
+it holds the lock: in PostgreSQL's READ COMMITTED a statement sees what was
+committed when it began, so a busy check made in the statement that waited
+for the lock would not see the first worker's job and would lease a second
+one on the same cobot (two use-case cases sharing cobots did exactly that).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import pytest
+from django.contrib.auth.models import User
+from django.db import connection, connections, transaction
+
+from hrc.cases import jobs
+from hrc.cases.choices import JobState
+from hrc.cases.launcher import RedisProcess
+from hrc.cases.models import Job
+from hrc.organisations.models import Organisation
+from tests import factories
+
+
+def _one_cobot_task() -> dict[str, Any]:
+    """The cobot picks (its job queued as the case starts) while the operator loads the cell."""
+    transitions = [
+        {"id": "split"},
+        {"id": "tc1", "performer": "c", "label": "pick", "task": {"step": {"number": 3}}},
+        {"id": "to1", "performer": "o", "label": "load the cell"},
+        {"id": "join"},
+    ]
+    arcs = "p0>split split>p1 p1>tc1 tc1>p2 p2>join split>p3 p3>to1 to1>p4 p4>join join>p5"
+    return {
+        "format": "hrc-pattern/1",
+        "name": "pick beside loading",
+        "actors": [{"id": "c", "type": "cobot"}, {"id": "o", "type": "operator"}],
+        "processes": [
+            {
+                "id": "N",
+                "workpiece": "w",
+                "actors": ["c", "o"],
+                "places": [{"id": f"p{i}", "tokens": 1 if i == 0 else 0} for i in range(6)],
+                "transitions": transitions,
+                "arcs": [arc.split(">") for arc in arcs.split()],
+            }
+        ],
+        "constraints": [],
+    }
+
+
+def _waiting_for_a_lock() -> bool:
+    with connection.cursor() as cursor:
+        cursor.execute(
+            "SELECT count(*) FROM pg_stat_activity "
+            "WHERE datname = current_database() AND wait_event_type = 'Lock'"
+        )
+        return bool(cursor.fetchone()[0])
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
+) -> None:
+    # `broker`: the cases' doorbells go to a private redis-server that no worker reads.
+    version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
+    cobot = factories.make_cobot(organisation, name="shared")
+    mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
+    for _ in range(2):
+        factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    assert Job.objects.filter(cobot=cobot, state=JobState.QUEUED).count() == 2
+
+    leased = threading.Event()
+    release = threading.Event()
+    results: dict[str, Any] = {}
+
+    def first() -> None:
+        try:
+            with transaction.atomic():  # the lease's own transaction, held open a moment
+                results["first"] = jobs.lease_next_job(cobot.pk)
+                leased.set()
+                release.wait(30)
+        finally:
+            connections.close_all()
+
+    def second() -> None:
+        try:
+            results["second"] = jobs.lease_next_job(cobot.pk)
+        finally:
+            connections.close_all()
+
+    holder = threading.Thread(target=first)
+    holder.start()
+    assert leased.wait(30)
+    reacher = threading.Thread(target=second)
+    reacher.start()
+    deadline = time.monotonic() + 30
+    while not _waiting_for_a_lock():  # the second lease has begun and waits for the cobot
+        assert time.monotonic() < deadline, "the second lease never waited for the cobot"
+        time.sleep(0.01)
+    release.set()
+    holder.join(30)
+    reacher.join(30)
+
+    assert results["first"] is not None
+    assert results["second"] is None  # the cobot is busy with the first job
+    assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
