@@ -102,13 +102,16 @@ def live_url(django_db_setup: None, tmp_path_factory: pytest.TempPathFactory) ->
             server.kill()
 
 
-@pytest.fixture(scope="session")
+# Module scope, not session: while Playwright's sync API is up, its event loop
+# counts as running in this thread, and every asyncio test that the same
+# xdist worker runs after the browser tests would fail to start its own.
+@pytest.fixture(scope="module")
 def playwright() -> Iterator[Playwright]:
     with sync_playwright() as driver:
         yield driver
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def browser(playwright: Playwright) -> Iterator[Browser]:
     browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
     yield browser
