@@ -62,6 +62,7 @@ bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC 
 	$(PY) -m bench.runtime
 	$(PY) -m bench.editor
 	$(PY) -m bench.live
+	$(PY) -m bench.use_cases
 
 lock:  ## re-resolve requirements/*.in into the lock files
 	python3 -m venv /tmp/hrc-lock && /tmp/hrc-lock/bin/pip -q install uv
