@@ -29,6 +29,8 @@ from hrc.patterns.selectors import latest_version
 from hrc.patterns.services import PublishRefused
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "patterns" / "examples"
+# The prototype's seven use cases, runnable with their data, beside the thesis' examples.
+USE_CASES = "use_cases"
 
 
 @dataclass(frozen=True)
@@ -47,9 +49,9 @@ def load_examples(
     team: Team,
     cobots: Sequence[Cobot],
 ) -> list[Loaded]:
-    """Publishes every *.json in `folder` (sorted by name) and maps each version's actors."""
+    """Publishes every example file in `folder` (example_files) and maps each version's actors."""
     results = []
-    for path in sorted(folder.glob("*.json")) if folder.is_dir() else []:
+    for path in example_files(folder):
         try:
             version, outcome = ensure_published(organisation, engineer, path)
         except (OSError, ValueError, FormatError, ValidationError, PublishRefused) as exc:
@@ -61,6 +63,11 @@ def load_examples(
             outcome += f"; actors not mapped: {exc}"
         results.append(Loaded(path.name, outcome))
     return results
+
+
+def example_files(folder: Path) -> list[Path]:
+    """The *.json in `folder`, then those in its use_cases/ folder, each sorted by name."""
+    return sorted(folder.glob("*.json")) + sorted((folder / USE_CASES).glob("*.json"))
 
 
 @transaction.atomic

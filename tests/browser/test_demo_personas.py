@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Page, Response, expect
 
-from hrc.demo.library import EXAMPLES_DIR
+from hrc.demo.library import EXAMPLES_DIR, example_files
 from hrc.demo.organisation import PERSONAS, Persona
 from tests.demo.rig import DemoRun
 
@@ -41,7 +41,7 @@ def _tablet_works(page: Page) -> None:
 def _editor_works(page: Page) -> None:
     """The example library is listed; the first example opens in the editor, checked valid."""
     rows = page.locator("table tbody tr")
-    expect(rows).to_have_count(len(list(EXAMPLES_DIR.glob("*.json"))))
+    expect(rows).to_have_count(len(example_files(EXAMPLES_DIR)))
     rows.first.get_by_role("link", name="Open").click()
     expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
     expect(page.get_by_label("Pattern class")).to_have_attribute(

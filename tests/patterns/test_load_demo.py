@@ -11,6 +11,7 @@ from django.core.management import CommandError, call_command
 
 from hrc.cases import services as case_services
 from hrc.cobots.models import Cobot
+from hrc.demo.library import example_files
 from hrc.organisations.models import Membership, Organisation, Team
 from hrc.patterns.management.commands.load_demo import EXAMPLES_DIR
 from hrc.patterns.models import PatternModel, PatternVersion
@@ -107,8 +108,8 @@ def test_every_example_can_start_a_case_with_the_demo_people_and_cobots() -> Non
 
 @pytest.mark.django_db
 def test_every_shipped_example_is_published_as_version_1() -> None:
-    examples = sorted(EXAMPLES_DIR.glob("*.json"))
-    assert examples, "the example library is empty"
+    examples = example_files(EXAMPLES_DIR)
+    assert len(examples) == 8 + 7, "the thesis' examples and the prototype's use cases"
     _load_demo("--strict")
     names = {json.loads(path.read_text())["name"] for path in examples}
     patterns = PatternModel.objects.filter(organisation__slug="demo-plant")
