@@ -304,15 +304,6 @@ BPMN = """<?xml version="1.0" encoding="UTF-8"?>
 </definitions>"""
 
 
-# The import endpoint answers a browser's XML with 415: DRF's CSRF check for session users
-# parses the body, and the API has no XML parser (hrc/api). Reported; these turn into
-# failures (strict) as soon as it is fixed, to be made plain tests again.
-XML_IMPORT_REFUSED = pytest.mark.xfail(
-    strict=True,
-    reason="POST /api/patterns/import/ with an XML body and session auth is a 415 (CSRF check parses it)",
-)
-
-
 def test_a_malformed_file_changes_nothing_and_says_where(
     page: Page,
     live_url: str,
@@ -352,7 +343,6 @@ def test_a_malformed_file_changes_nothing_and_says_where(
     assert pattern.draft == json.loads((EXAMPLES / "synch_1o1c_assembly.json").read_text())
 
 
-@XML_IMPORT_REFUSED
 def test_a_bpmn_feature_hrc_does_not_map_is_refused_by_element_and_changes_nothing(
     page: Page,
     live_url: str,
@@ -374,7 +364,6 @@ def test_a_bpmn_feature_hrc_does_not_map_is_refused_by_element_and_changes_nothi
     assert PatternModel.objects.count() == 1
 
 
-@XML_IMPORT_REFUSED
 def test_a_bpmn_file_imports_as_a_new_pattern_in_its_lanes(
     page: Page,
     live_url: str,

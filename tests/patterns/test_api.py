@@ -5,9 +5,11 @@ from typing import Any
 
 import pytest
 from django.contrib.auth.models import User
+from django.test import Client
 from rest_framework.test import APIClient
 
 from hrc.engine import read_pattern
+from hrc.engine.pnml import pattern_to_pnml
 from hrc.organisations.models import Organisation
 from hrc.patterns import services
 from hrc.patterns.models import PatternModel, PatternVersion
@@ -408,6 +410,27 @@ def test_an_unreadable_import_is_a_400(
     assert response.status_code == 400
     assert response.data["detail"]
     assert not PatternModel.objects.exists()
+
+
+@pytest.mark.parametrize("content_type", ["application/xml", "text/xml", "application/json"])
+def test_a_signed_in_browser_imports_with_its_csrf_token(engineer: User, content_type: str) -> None:
+    # A session user goes through DRF's CSRF check, which reads the body before the view.
+    browser = Client(enforce_csrf_checks=True)
+    browser.force_login(engineer)
+    browser.get("/accounts/login/")  # sets the csrftoken cookie
+    token = browser.cookies["csrftoken"].value
+    body = (
+        json.dumps(factories.valid_document()).encode()
+        if content_type == "application/json"
+        else pattern_to_pnml(read_pattern(factories.valid_document())).encode()
+    )
+
+    response = browser.post(
+        "/api/patterns/import/", body, content_type=content_type, HTTP_X_CSRFTOKEN=token
+    )
+
+    assert response.status_code == 201, response.content
+    assert PatternModel.objects.count() == 1
 
 
 def test_a_10_mb_import_is_refused_with_413(engineer_client: APIClient) -> None:

@@ -29,7 +29,13 @@ from rest_framework.response import Response
 
 from hrc.api.exceptions import Rejected
 from hrc.api.negotiation import FormatParameterForViews
-from hrc.api.parsers import parse_json_body, read_body
+from hrc.api.parsers import (
+    LimitedJSONParser,
+    TextXMLParser,
+    XMLBodyParser,
+    parse_json_body,
+    read_body,
+)
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
 from hrc.patterns import services
 from hrc.patterns.api.serializers import (
@@ -103,6 +109,13 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
 
     def get_queryset(self) -> QuerySet[PatternModel]:
         return patterns_visible_to(self.request.user).order_by("name", "id")
+
+    def initial(self, request: Request, *args: Any, **kwargs: Any) -> None:
+        if self.action == "import_document":
+            # The import reads the raw body itself. Read it now, before a signed-in
+            # browser's CSRF check makes DRF parse it and leave nothing to read.
+            read_body(request._request)
+        super().initial(request, *args, **kwargs)
 
     def get_serializer_class(self) -> type[serializers.BaseSerializer[PatternModel]]:
         return PatternSummarySerializer if self.action == "list" else PatternSerializer
@@ -179,7 +192,10 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         request={"application/json": OpenApiTypes.OBJECT, "application/xml": OpenApiTypes.STR},
         responses={201: PatternSerializer, 400: DocumentErrorSerializer},
     )
-    @action(detail=False, methods=["post"], url_path="import", url_name="import")
+    @action(
+        detail=False, methods=["post"], url_path="import", url_name="import",
+        parser_classes=[LimitedJSONParser, XMLBodyParser, TextXMLParser],
+    )  # fmt: skip
     def import_document(self, request: Request) -> Response:
         """Creates a pattern from an hrc-pattern/1 document, a PNML file or a BPMN 2.0 file.
 
