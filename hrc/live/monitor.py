@@ -80,6 +80,8 @@ class _Handler:
 
     def datachange_notification(self, node: Node, value: Any, data: Any) -> None:
         path = self.paths.get(node.nodeid)
+        if path == urua.STATE_HEARTBEAT:
+            return  # it only keeps the subscription busy (see _watch)
         if path == DISPLAY:
             self.watched.update(display=str(value or ""))
         elif path == JOINTS:
@@ -171,7 +173,12 @@ class Monitor:
         client.connection_lost_callback = on_lost
         await asyncio.wait_for(client.connect(), 5)
         try:
-            paths = {client.get_node(urua.node_id(watched.name, p)).nodeid: p for p in WATCHED}
+            # The gateway's heartbeat changes 4 times a second: without it a quiet cobot's
+            # subscription looks stale to asyncua (publishing interval 0) and is recreated.
+            watched_paths = [*WATCHED, urua.STATE_HEARTBEAT]
+            paths = {
+                client.get_node(urua.node_id(watched.name, p)).nodeid: p for p in watched_paths
+            }
             handler = _Handler(watched, paths)
             parameters = ua.CreateSubscriptionParameters(
                 RequestedPublishingInterval=0, RequestedLifetimeCount=300,

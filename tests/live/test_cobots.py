@@ -202,3 +202,12 @@ def test_an_outsider_cannot_stop_our_cell(
     assert not CellStop.objects.exists()
     cobot.refresh_from_db()
     assert cobot.stopped_at is None
+
+
+def test_a_quiet_cobots_subscription_is_kept_not_recreated(
+    monitor: MonitorProcess, cobot: Cobot
+) -> None:
+    # Nothing happens at the cell; only the gateway's heartbeat keeps the subscription busy.
+    time.sleep(4.0)
+
+    assert "is stale" not in monitor.log.read_text()
