@@ -186,7 +186,7 @@ def _execute(lease: Lease) -> dict[str, Any]:
     command = lease.command
     if lease.kind == WorkItemKind.DEVICE:
         return _call_device(driver, lease)
-    _prepare(driver, command["program"], lease.timeout)
+    _prepare(driver, lease.cobot.pk, command["program"], lease.timeout)
     step = StepCommand(
         step=command["number"], fence=Fence(lease.job_id, lease.attempt),
         workspace=command["workspace"], poses=command["poses"],
@@ -200,11 +200,12 @@ def _execute(lease: Lease) -> dict[str, Any]:
     return {"outcome": result.outcome, "seconds": round(result.seconds, 3)}
 
 
-def _prepare(driver: SyncDriver, program: str, timeout: float) -> None:
+def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) -> None:
     """Loads and plays the step's program when the cobot is idle in another one.
 
     Never powers the arm on and never clears a stop: a cobot that is not
-    running (powered, brakes released) is an incident for a person.
+    running (powered, brakes released), or whose cell a tablet stopped after
+    this job was leased, is an incident for a person.
     """
 
     def ready(state: dict[str, Any]) -> bool:
@@ -223,6 +224,13 @@ def _prepare(driver: SyncDriver, program: str, timeout: float) -> None:
         raise CobotNotReady(
             f"{driver.name} is in robot mode {state.get('RobotMode')!r}: power it on and release "
             "the brakes at the cell; hrc does not do that by itself.",
+            state=state,
+        )
+    # A STOP from a tablet may have paused the program since the lease: playing it
+    # again here would undo the STOP.
+    if Cobot.objects.filter(pk=cobot_id, stopped_at__isnull=False).exists():
+        raise CobotNotReady(
+            f"{driver.name}'s cell was stopped from a tablet; resume it there, then retry.",
             state=state,
         )
     if urua.program_base_name(loaded) != program:
