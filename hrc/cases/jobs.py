@@ -105,7 +105,10 @@ def lease_next_job(cobot_id: int) -> Lease | None:
         # The lock first, then the reasons to wait in a statement of their own: a statement
         # sees what was committed when it began, so one that waited for the lock would not
         # see the job the lease before it took (READ COMMITTED; tests/cases/test_cobot_lock.py).
-        Cobot.objects.select_for_update(of=("self",)).filter(pk=cobot_id).exists()
+        # NO KEY: a case service inserting a job or an interruption takes a key-share lock
+        # on the cobot row (the foreign key) while it holds its case; FOR UPDATE would
+        # wait for it while we wait for the case, a deadlock.
+        Cobot.objects.select_for_update(of=("self",), no_key=True).filter(pk=cobot_id).exists()
         busy = Job.objects.filter(cobot=OuterRef("pk"), state=JobState.RUNNING)
         cobot = Cobot.objects.annotate(
             busy=Exists(busy), paused=Exists(_unsettled_interruptions(OuterRef("pk")))
@@ -158,7 +161,11 @@ def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -
 def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
     """Both rows locked, in the project's lock order (case, then job); the work item read along."""
     case = services.lock_case(case_id)
-    job = Job.objects.select_for_update(of=("self",)).select_related("work_item").get(pk=job_id)
+    job = (
+        Job.objects.select_for_update(of=("self",), no_key=True)
+        .select_related("work_item")
+        .get(pk=job_id)
+    )
     return case, job
 
 

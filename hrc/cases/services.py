@@ -650,7 +650,11 @@ def _fail(case: Case, message: str) -> None:
 
 def lock_case(case_id: int) -> Case:
     """The case, its row locked until the transaction ends (its version read along, not locked)."""
-    return Case.objects.select_for_update(of=("self",)).select_related("version").get(pk=case_id)
+    return (
+        Case.objects.select_for_update(of=("self",), no_key=True)
+        .select_related("version")
+        .get(pk=case_id)
+    )
 
 
 def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:

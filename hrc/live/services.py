@@ -97,7 +97,7 @@ def resume_cell(organisation: Organisation, cell: str, *, by: User, confirmed: b
             raise StopError(f"{_name(cell)} is not stopped.")
         stop.resumed_by, stop.resumed_at = by, timezone.now()
         stop.save(update_fields=["resumed_by", "resumed_at"])
-        held = list(Cobot.objects.select_for_update().filter(pk__in=stop.cobots))
+        held = list(Cobot.objects.select_for_update(no_key=True).filter(pk__in=stop.cobots))
         Cobot.objects.filter(pk__in=[c.pk for c in held]).update(stopped_at=None)
         for cobot in held:
             broadcast.cobot_queue_on_commit(cobot.pk)
@@ -122,7 +122,9 @@ def _active(organisation: Organisation, cell: str) -> CellStop | None:
 
 
 def _cell_cobots(organisation: Organisation, cell: str) -> list[Cobot]:
-    cobots = Cobot.objects.select_for_update().filter(organisation=organisation, is_active=True)
+    cobots = Cobot.objects.select_for_update(no_key=True).filter(
+        organisation=organisation, is_active=True
+    )
     return list(cobots.filter(cell=cell) if cell else cobots)
 
 
