@@ -53,12 +53,6 @@ from typing import Any, cast
 
 from defusedxml import (  # type: ignore[import-untyped, unused-ignore]
     DefusedXmlException,
-    DTDForbidden,
-    EntitiesForbidden,
-    ExternalReferenceForbidden,
-)
-from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-ignore]
-    fromstring as _safe_fromstring,
 )
 from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-ignore]
     iterparse as _safe_iterparse,
@@ -68,6 +62,7 @@ from hrc.engine.bpmn_net import EVENT_KINDS, GATEWAY_KINDS, TASK_KINDS, Flow, Fl
 from hrc.engine.document import FORMAT, FormatError, read_pattern
 from hrc.engine.issues import Issue, error
 from hrc.engine.model import Pattern
+from hrc.engine.pnml import parse_xml
 
 BPMN_NAMESPACE = "http://www.omg.org/spec/BPMN/20100524/MODEL"
 BPMNDI_NAMESPACE = "http://www.omg.org/spec/BPMN/20100524/DI"
@@ -160,33 +155,6 @@ def is_bpmn(text: str | bytes) -> bool:
 
 def _refuse(message: str, *elements: str) -> FormatError:
     return FormatError([error("format", message, *elements)])
-
-
-def parse_xml(text: str | bytes, what: str) -> ET.Element:
-    """A parsed XML tree; FormatError for malformed XML (with its line and column) and DTDs."""
-    try:
-        return cast(
-            ET.Element,
-            _safe_fromstring(text, forbid_dtd=True, forbid_entities=True, forbid_external=True),
-        )
-    except DTDForbidden:
-        raise _refuse(
-            f"The document has a DTD (<!DOCTYPE ...>), which is refused: {what} needs none, and a"
-            " DTD can define entities that expand without limit (an XML bomb) or read other files"
-            " (external entities)."
-        ) from None
-    except EntitiesForbidden as exc:
-        raise _refuse(f"The document declares the entity {exc.name!r}, which is refused.") from None
-    except ExternalReferenceForbidden:
-        raise _refuse("The document refers to an external resource, which is refused.") from None
-    except DefusedXmlException as exc:
-        raise _refuse(f"The document was refused as unsafe XML: {exc}.") from None
-    except ET.ParseError as exc:
-        raise _refuse(f"The document is not XML: {exc}.") from None
-    except UnicodeError:
-        raise _refuse("The document is not valid Unicode text.") from None
-    except LookupError as exc:  # an encoding declaration Python does not know
-        raise _refuse(f"The document is in an unknown encoding: {exc}.") from None
 
 
 def _local(element: ET.Element) -> tuple[str, str]:

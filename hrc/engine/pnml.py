@@ -80,7 +80,7 @@ def pnml_to_pattern(text: str | bytes) -> Pattern:
     constraints; PNML from other tools becomes one process per `<net>` with no
     actors. DTDs are refused, so no entity can expand or reach outside the text.
     """
-    return read_pattern(_Reader(_parse_xml(text)).document())
+    return read_pattern(_Reader(parse_xml(text, "PNML")).document())
 
 
 # Writing ---------------------------------------------------------------------------------
@@ -272,7 +272,9 @@ def _refuse(message: str) -> FormatError:
     return FormatError([error("format", message)])
 
 
-def _parse_xml(text: str | bytes) -> ET.Element:
+def parse_xml(text: str | bytes, what: str) -> ET.Element:
+    """A parsed XML tree of a `what` file (PNML, BPMN); FormatError for malformed or unsafe XML
+    (DTDs, entities, external references), with the parser's line and column."""
     try:
         return cast(
             ET.Element,
@@ -280,8 +282,8 @@ def _parse_xml(text: str | bytes) -> ET.Element:
         )
     except DTDForbidden:
         raise _refuse(
-            "The document has a DTD (<!DOCTYPE ...>), which is refused: PNML needs none, and a DTD"
-            " can define entities that expand without limit (an XML bomb) or read other files"
+            f"The document has a DTD (<!DOCTYPE ...>), which is refused: {what} needs none, and a"
+            " DTD can define entities that expand without limit (an XML bomb) or read other files"
             " (external entities)."
         ) from None
     except EntitiesForbidden as exc:
