@@ -44,6 +44,7 @@ from bench.runtime_rig import (
     RESULTS_DIR,
     ROOT,
     SETTINGS_MODULE,
+    Observer,
     _set_up_django,
     database_server,
     scratch_database,
@@ -190,67 +191,6 @@ class Tablets:
 # The cobot's output register ----------------------------------------------------------------
 
 
-class OutputObserver:
-    """Notes the perf_counter() at which the cobot's output Int26 first held each value."""
-
-    def __init__(self, endpoint: str, cobot: str) -> None:
-        self.endpoint, self.cobot = endpoint, cobot
-        self.loop = asyncio.new_event_loop()
-        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
-        self.seen: dict[int, float] = {}
-        self.wall: dict[int, float] = {}  # time.time() of the same moments, to compare with rows
-        self.changed = threading.Condition()
-        self.client: Any = None
-
-    def start(self) -> OutputObserver:
-        self.thread.start()
-        asyncio.run_coroutine_threadsafe(self._connect(), self.loop).result(30)
-        return self
-
-    async def _connect(self) -> None:
-        from asyncua import Client, ua
-
-        from hrc.cobots import urua
-
-        self.client = Client(self.endpoint)
-        await self.client.connect()
-        node = self.client.get_node(
-            urua.node_id(self.cobot, urua.register_path("Outputs", urua.FENCE_STEP))
-        )
-        beat = self.client.get_node(urua.node_id(self.cobot, urua.STATE_HEARTBEAT))
-        parameters = ua.CreateSubscriptionParameters(
-            RequestedPublishingInterval=0, RequestedLifetimeCount=300,
-            RequestedMaxKeepAliveCount=100, PublishingEnabled=True,
-        )  # fmt: skip
-        self._node_id = node.nodeid
-        subscription = await self.client.create_subscription(parameters, self)
-        await subscription.subscribe_data_change([node, beat], queuesize=16, sampling_interval=0)
-
-    def datachange_notification(self, node: Any, value: Any, data: Any) -> None:
-        now, wall = time.perf_counter(), time.time()
-        if node.nodeid == self._node_id:
-            with self.changed:
-                self.seen.setdefault(int(value), now)
-                self.wall.setdefault(int(value), wall)
-                self.changed.notify_all()
-
-    def status_change_notification(self, status: Any) -> None:
-        pass
-
-    def seen_at(self, value: int, timeout: float = 30.0) -> float:
-        with self.changed:
-            if not self.changed.wait_for(lambda: value in self.seen, timeout):
-                raise TimeoutError(f"output Int26 never became {value}")
-            return self.seen[value]
-
-    def close(self) -> None:
-        if self.client is not None:
-            with contextlib.suppress(Exception):
-                asyncio.run_coroutine_threadsafe(self.client.disconnect(), self.loop).result(10)
-        self.loop.call_soon_threadsafe(self.loop.stop)
-        self.thread.join(10)
-
-
 # The rig --------------------------------------------------------------------------------------
 
 
@@ -299,12 +239,13 @@ class Rig:
     version: Any
     cobot: Any
     tablets: Tablets
-    observer: OutputObserver
+    observer: Observer  # the cobot's output Int26
 
 
 @contextlib.contextmanager
 def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
     from hrc.cases.launcher import RedisProcess, WorkerProcess
+    from hrc.cobots import urua
     from hrc.cobots.gateway.launcher import GatewayProcess
 
     with contextlib.ExitStack() as stack:
@@ -332,7 +273,9 @@ def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
         tablets = Tablets(url, f"http://127.0.0.1:{server.port}", made.pop("cookies"))
         tablets.start()
         stack.callback(tablets.close)
-        observer = OutputObserver(gateway.endpoint, "cobot1").start()
+        observer = Observer(
+            gateway.endpoint, "cobot1", [urua.FENCE_STEP], direction="Outputs"
+        ).start()
         stack.callback(observer.close)
         yield Rig(tablets=tablets, observer=observer, **made)
 
@@ -390,6 +333,7 @@ def _close_connections() -> None:
 def measure_ours(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:
     from hrc.cases import services
     from hrc.cases.models import CaseEvent, Job
+    from hrc.cobots import urua
 
     latencies: list[float] = []
     spreads: list[float] = []
@@ -401,12 +345,14 @@ def measure_ours(bench: Rig, settings: Settings, progress: Callable[[str], None]
         jobs = Job.objects.filter(case=case).values_list("pk", flat=True)
         job_id = _until(jobs.first)
         applied = bench.tablets.wait()
-        done = bench.observer.seen_at(job_id)
+        done = bench.observer.seen_at(urua.FENCE_STEP, job_id)
         if index >= settings.warmup:
             latencies += [(at - done) * 1000 for at in applied]
             spreads.append((max(applied) - min(applied)) * 1000)
             offered = CaseEvent.objects.get(case=case, type="task-offered", task="to1").at
-            to_offer.append((offered.timestamp() - bench.observer.wall[job_id]) * 1000)
+            to_offer.append(
+                (offered.timestamp() - bench.observer.wall_at(urua.FENCE_STEP, job_id)) * 1000
+            )
     return {
         "ours": summary(latencies),
         "register_to_offer_recorded": summary(to_offer),

@@ -197,18 +197,23 @@ def scratch_database(server: str) -> Iterator[str]:
 
 
 class Observer:
-    """An OPC UA client of one gateway, on its own thread, noting when input registers change.
+    """An OPC UA client of one gateway, on its own thread, noting when registers change.
 
     It subscribes as the driver does (publishing interval 0, sampling 0) and
-    keeps the perf_counter() of the first notification of each (register,
-    value): it sees a written value when and as the cobot's program would.
+    keeps the perf_counter() (and time.time(), to compare with rows) of the
+    first notification of each (register, value): it sees a written input
+    when and as the cobot's program would, an output when a client would.
     """
 
-    def __init__(self, endpoint: str, cobot: str, registers: Sequence[str]) -> None:
+    def __init__(
+        self, endpoint: str, cobot: str, registers: Sequence[str], direction: str = "Inputs"
+    ) -> None:
         self.endpoint, self.cobot, self.registers = endpoint, cobot, tuple(registers)
+        self.direction = direction
         self._loop = asyncio.new_event_loop()
         self._thread = threading.Thread(target=self._loop.run_forever, daemon=True)
         self._seen: dict[tuple[str, Any], float] = {}
+        self._wall: dict[tuple[str, Any], float] = {}
         self._names: dict[Any, str] = {}
         self._changed = threading.Condition()
         self._client: Any = None
@@ -226,7 +231,9 @@ class Observer:
         self._client = Client(self.endpoint)
         await self._client.connect()
         nodes = [
-            self._client.get_node(urua.node_id(self.cobot, urua.register_path("Inputs", name)))
+            self._client.get_node(
+                urua.node_id(self.cobot, urua.register_path(self.direction, name))
+            )
             for name in self.registers
         ]
         self._names = {node.nodeid: name for node, name in zip(nodes, self.registers, strict=True)}
@@ -243,11 +250,12 @@ class Observer:
         await subscription.subscribe_data_change(nodes, queuesize=16, sampling_interval=0)
 
     def datachange_notification(self, node: Any, value: Any, data: Any) -> None:
-        now = time.perf_counter()
+        now, wall = time.perf_counter(), time.time()
         register = self._names.get(node.nodeid)
         if register is not None:  # not the heartbeat
             with self._changed:
                 self._seen.setdefault((register, value), now)
+                self._wall.setdefault((register, value), wall)
                 self._changed.notify_all()
 
     def status_change_notification(self, status: Any) -> None:
@@ -259,6 +267,11 @@ class Observer:
             if not self._changed.wait_for(lambda: (register, value) in self._seen, timeout):
                 raise TimeoutError(f"{self.cobot}: {register} never became {value}")
             return self._seen[(register, value)]
+
+    def wall_at(self, register: str, value: int, timeout: float = 30.0) -> float:
+        """time.time() of the moment seen_at gives."""
+        self.seen_at(register, value, timeout)
+        return self._wall[(register, value)]
 
     def close(self) -> None:
         if self._client is not None:
