@@ -8,11 +8,6 @@ which the run keeps.
 """
 
 import os
-import socket
-import subprocess
-import sys
-import time
-import urllib.request
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -30,6 +25,7 @@ from playwright.sync_api import (
 
 from tests import factories
 from tests.cases.conftest import broker, start_worker  # noqa: F401  # the tablet tests' worker
+from tests.live.server import LiveServer
 
 CHROMIUM = "/usr/bin/chromium"
 SCREENSHOTS = Path(settings.BASE_DIR) / "var" / "screenshots"
@@ -42,64 +38,12 @@ TABLET = ViewportSize(width=1280, height=800)
 os.environ.setdefault("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
-
-
-def _wait_until_serving(url: str, server: subprocess.Popen[bytes], log: Path) -> None:
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        if server.poll() is not None:
-            raise RuntimeError(f"the test server exited; its log:\n{log.read_text()}")
-        try:
-            urllib.request.urlopen(f"{url}/accounts/login/", timeout=1).close()
-            return
-        except OSError:
-            time.sleep(0.1)
-    raise RuntimeError(f"the test server did not answer within 30 s; its log:\n{log.read_text()}")
-
-
 @pytest.fixture(scope="session")
 def live_url(django_db_setup: None, tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     """The base URL of an ASGI server on the test database."""
-    from django.db import connection
-
-    database = connection.settings_dict
-    port = _free_port()
-    log = tmp_path_factory.mktemp("server") / "server.log"
-    environment = {
-        **os.environ,
-        "DJANGO_SETTINGS_MODULE": "hrc.settings.test",
-        "DATABASE_URL": f"postgres://{database['USER']}@{database['HOST']}:{database['PORT']}/{database['NAME']}",
-        "DJANGO_ALLOW_ASYNC_UNSAFE": "",
-    }
-    with log.open("wb") as output:
-        server = subprocess.Popen(
-            [
-                sys.executable,
-                "manage.py",
-                "runserver",
-                "--noreload",
-                "--insecure",
-                f"127.0.0.1:{port}",
-            ],
-            cwd=settings.BASE_DIR,
-            env=environment,
-            stdout=output,
-            stderr=subprocess.STDOUT,
-        )
-    url = f"http://127.0.0.1:{port}"
-    try:
-        _wait_until_serving(url, server, log)
-        yield url
-    finally:
-        server.terminate()
-        try:
-            server.wait(10)
-        except subprocess.TimeoutExpired:
-            server.kill()
+    server = LiveServer(tmp_path_factory.mktemp("server") / "server.log").start()
+    yield server.url
+    server.stop()
 
 
 # Module scope, not session: while Playwright's sync API is up, its event loop

@@ -24,22 +24,15 @@ from django.test import Client
 from hrc.cobots.gateway.launcher import free_port
 
 
-class LiveServer:
+class _ManagePy:
+    """A `manage.py` child process on the test database, its output in `log`."""
+
     def __init__(self, log: Path, environment: Mapping[str, str] | None = None) -> None:
-        self.port = free_port()
         self.log = log
         self.environment = dict(environment or {})
         self.process: subprocess.Popen[bytes] | None = None
 
-    @property
-    def url(self) -> str:
-        return f"http://127.0.0.1:{self.port}"
-
-    @property
-    def ws_url(self) -> str:
-        return f"ws://127.0.0.1:{self.port}"
-
-    def start(self, timeout: float = 30.0) -> Self:
+    def _spawn(self, *arguments: str) -> subprocess.Popen[bytes]:
         database = connection.settings_dict
         environment = {
             **os.environ,
@@ -51,13 +44,40 @@ class LiveServer:
         }
         with self.log.open("ab") as output:
             self.process = subprocess.Popen(
-                [sys.executable, "manage.py", "runserver", "--noreload", "--insecure",
-                 f"127.0.0.1:{self.port}"],
+                [sys.executable, "manage.py", *arguments],
                 cwd=settings.BASE_DIR, env=environment, stdout=output, stderr=subprocess.STDOUT,
             )  # fmt: skip
+        return self.process
+
+    def stop(self) -> None:
+        if self.process is not None and self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(10)
+        self.process = None
+
+
+class LiveServer(_ManagePy):
+    def __init__(self, log: Path, environment: Mapping[str, str] | None = None) -> None:
+        super().__init__(log, environment)
+        self.port = free_port()
+
+    @property
+    def url(self) -> str:
+        return f"http://127.0.0.1:{self.port}"
+
+    @property
+    def ws_url(self) -> str:
+        return f"ws://127.0.0.1:{self.port}"
+
+    def start(self, timeout: float = 30.0) -> Self:
+        process = self._spawn("runserver", "--noreload", "--insecure", f"127.0.0.1:{self.port}")
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            if self.process.poll() is not None:
+            if process.poll() is not None:
                 raise RuntimeError(f"the test server exited; its log:\n{self.log.read_text()}")
             try:
                 urllib.request.urlopen(f"{self.url}/accounts/login/", timeout=1).close()
@@ -67,16 +87,6 @@ class LiveServer:
         self.stop()
         raise RuntimeError(f"the test server did not answer in time:\n{self.log.read_text()}")
 
-    def stop(self) -> None:
-        if self.process is not None and self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(10)
-        self.process = None
-
 
 def session_cookie(user: User) -> str:
     """A signed-in session for `user` in the database the server reads, as a Cookie header."""
@@ -85,44 +95,17 @@ def session_cookie(user: User) -> str:
     return f"{settings.SESSION_COOKIE_NAME}={client.cookies[settings.SESSION_COOKIE_NAME].value}"
 
 
-class MonitorProcess:
+class MonitorProcess(_ManagePy):
     """`manage.py live_cobots` on the test database: the cobot panel's source."""
 
-    def __init__(self, log: Path, environment: Mapping[str, str] | None = None) -> None:
-        self.log = log
-        self.environment = dict(environment or {})
-        self.process: subprocess.Popen[bytes] | None = None
-
     def start(self, timeout: float = 30.0) -> Self:
-        database = connection.settings_dict
-        environment = {
-            **os.environ,
-            "DJANGO_SETTINGS_MODULE": "hrc.settings.test",
-            "DATABASE_URL": f"postgres://{database['USER']}@{database['HOST']}:{database['PORT']}/{database['NAME']}",
-            "PYTHONUNBUFFERED": "1",
-            **self.environment,
-        }
-        with self.log.open("ab") as output:
-            self.process = subprocess.Popen(
-                [sys.executable, "manage.py", "live_cobots"],
-                cwd=settings.BASE_DIR, env=environment, stdout=output, stderr=subprocess.STDOUT,
-            )  # fmt: skip
+        process = self._spawn("live_cobots")
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            if self.process.poll() is not None:
+            if process.poll() is not None:
                 raise RuntimeError(f"the monitor exited; its log:\n{self.log.read_text()}")
             if "live monitor watching" in self.log.read_text():
                 return self
             time.sleep(0.05)
         self.stop()
         raise RuntimeError(f"the monitor did not start:\n{self.log.read_text()}")
-
-    def stop(self) -> None:
-        if self.process is not None and self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(10)
-        self.process = None
