@@ -83,7 +83,10 @@ if REDIS_URL:
     CHANNEL_LAYERS = {
         "default": {
             "BACKEND": "channels_redis.core.RedisChannelLayer",
-            "CONFIG": {"hosts": [REDIS_URL]},
+            # A consumer waits for its next message in a blocking pop of 5 s (channels_redis);
+            # redis-py's default 5 s socket timeout would end an idle tablet's socket with
+            # a 1011 every few seconds. A longer one still notices a dead Redis.
+            "CONFIG": {"hosts": [{"address": REDIS_URL, "socket_timeout": 30}]},
         }
     }
     CELERY_BROKER_URL = REDIS_URL
