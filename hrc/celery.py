@@ -1,11 +1,30 @@
 """The Celery application; tasks live in each app's tasks.py."""
 
 import os
+from typing import Any
 
 from celery import Celery
+from celery.signals import task_postrun, task_prerun
 
 os.environ.setdefault("DJANGO_SETTINGS_MODULE", "hrc.settings.dev")
 
 app = Celery("hrc")
 app.config_from_object("django.conf:settings", namespace="CELERY")
 app.autodiscover_tasks()
+
+
+def _close_old_connections(task: Any = None, **kwargs: Any) -> None:
+    """A task is a request: connections past CONN_MAX_AGE or broken by an error are closed.
+
+    (Celery's fix-up would close them all; CELERY_DB_REUSE_MAX stops it.) Not
+    for an eager task: it runs inside its caller's request, perhaps in a transaction.
+    """
+    if getattr(getattr(task, "request", None), "is_eager", False):
+        return
+    from django.db import close_old_connections
+
+    close_old_connections()
+
+
+task_prerun.connect(_close_old_connections)
+task_postrun.connect(_close_old_connections)

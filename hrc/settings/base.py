@@ -70,7 +70,9 @@ TEMPLATES = [
 
 DATABASE_URL = env_url("DATABASE_URL", {"postgres", "postgresql", "sqlite"})
 if DATABASE_URL:
-    DATABASES = {"default": dj_database_url.parse(DATABASE_URL, conn_max_age=60)}
+    DATABASES = {
+        "default": dj_database_url.parse(DATABASE_URL, conn_max_age=60, conn_health_checks=True)
+    }
 else:
     # The embedded default: one file under var/, created by `migrate`.
     DATABASES = {
@@ -109,6 +111,13 @@ CELERY_TASK_PUBLISH_RETRY_POLICY = {
     "interval_max": 0.5,
 }
 CELERY_BROKER_CONNECTION_RETRY_ON_STARTUP = True
+# Celery's Django fix-up closes every database connection before and after each
+# task unless this is set: a new PostgreSQL session (a backend forked, its
+# authentication, Django's set-up) for every step, a few ms of two processes'
+# CPU. Set, it recycles them only every this many tasks; between, hrc.celery
+# applies CONN_MAX_AGE and the health check around each task as Django does
+# around each request.
+CELERY_DB_REUSE_MAX = 10_000
 CELERY_WORKER_HIJACK_ROOT_LOGGER = False
 
 AUTH_PASSWORD_VALIDATORS = [
