@@ -14,10 +14,11 @@ app.autodiscover_tasks()
 
 
 def _close_old_connections(task: Any = None, **kwargs: Any) -> None:
-    """A task is a request: connections past CONN_MAX_AGE or broken by an error are closed.
+    """A task is a request: its connection goes back to the pool (or, unpooled, is closed
+    past CONN_MAX_AGE or when an error broke it).
 
-    (Celery's fix-up would close them all; CELERY_DB_REUSE_MAX stops it.) Not
-    for an eager task: it runs inside its caller's request, perhaps in a transaction.
+    (Celery's fix-up would close the pool itself; CELERY_DB_REUSE_MAX stops it.)
+    Not for an eager task: it runs inside its caller's request, perhaps in a transaction.
     """
     if getattr(getattr(task, "request", None), "is_eager", False):
         return

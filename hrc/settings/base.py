@@ -70,9 +70,18 @@ TEMPLATES = [
 
 DATABASE_URL = env_url("DATABASE_URL", {"postgres", "postgresql", "sqlite"})
 if DATABASE_URL:
-    DATABASES = {
-        "default": dj_database_url.parse(DATABASE_URL, conn_max_age=60, conn_health_checks=True)
-    }
+    DATABASES = {"default": dj_database_url.parse(DATABASE_URL, conn_health_checks=True)}
+    if DATABASES["default"]["ENGINE"] == "django.db.backends.postgresql":
+        # A pool per process, not persistent connections: under ASGI each request runs
+        # on a thread of its own, whose connection would be a new PostgreSQL session
+        # per request (~3 ms of two processes' CPU). With the health checks on, the
+        # pool checks a connection as it is taken: one that a database restart broke
+        # is replaced, not handed out.
+        DATABASES["default"].setdefault("OPTIONS", {})["pool"] = {
+            "min_size": 1,
+            "max_size": int(env_str("HRC_DB_POOL_SIZE") or 10),
+            "timeout": 10,
+        }
 else:
     # The embedded default: one file under var/, created by `migrate`.
     DATABASES = {
@@ -112,11 +121,10 @@ CELERY_TASK_PUBLISH_RETRY_POLICY = {
 }
 CELERY_BROKER_CONNECTION_RETRY_ON_STARTUP = True
 # Celery's Django fix-up closes every database connection before and after each
-# task unless this is set: a new PostgreSQL session (a backend forked, its
-# authentication, Django's set-up) for every step, a few ms of two processes'
-# CPU. Set, it recycles them only every this many tasks; between, hrc.celery
-# applies CONN_MAX_AGE and the health check around each task as Django does
-# around each request.
+# task, and in a prefork child the whole pool with them, unless this is set: a
+# new PostgreSQL session for every step, a few ms of two processes' CPU. Set,
+# it does so only every this many tasks; between, hrc.celery gives the
+# connection back to the pool around each task as Django does around each request.
 CELERY_DB_REUSE_MAX = 10_000
 CELERY_WORKER_HIJACK_ROOT_LOGGER = False
 

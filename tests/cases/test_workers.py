@@ -1,4 +1,4 @@
-"""The Celery app's hooks (hrc/celery.py), in a real worker process."""
+"""Real Celery workers as cases use them: the app's hooks around each task (hrc/celery.py)."""
 
 from __future__ import annotations
 
@@ -6,24 +6,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from django.db import connection
 
 from hrc.cases.choices import CaseStatus
 from hrc.cases.launcher import WorkerProcess
 from hrc.cases.models import Case
 from hrc.cases.simulation import Simulation
 from tests.cases.patterns import cobot_chain
-
-# The workers and the broker come from tests/cases/conftest.py.
-pytest_plugins = ["tests.cases.conftest"]
-
-
-def _sessions_opened() -> int:
-    """Sessions ever opened on the test database (each counted by its backend, at the latest
-    when it ends)."""
-    with connection.cursor() as cursor:
-        cursor.execute("SELECT sessions FROM pg_stat_database WHERE datname = current_database()")
-        return int(cursor.fetchone()[0])
+from tests.postgres import sessions_opened
 
 
 @pytest.mark.django_db(transaction=True)
@@ -37,10 +26,10 @@ def test_a_worker_keeps_its_database_session_from_one_step_to_the_next(
     with simulation, simulation.running():
         first = simulation.start_cases(1)
         assert simulation.wait(first, timeout=60)
-        before = _sessions_opened()
+        before = sessions_opened()
         more = simulation.start_cases(3)
         assert simulation.wait(more, timeout=60)
-        opened = _sessions_opened() - before
+        opened = sessions_opened() - before
     assert opened <= 1  # the worker's own first one may be counted late
     statuses = set(Case.objects.filter(pk__in=first + more).values_list("status", flat=True))
     assert statuses == {CaseStatus.COMPLETED}
