@@ -658,7 +658,8 @@ def lock_case(case_id: int) -> Case:
 
 
 def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:
-    """The case (locked) and a fresh copy of an operator work item the user may perform."""
+    """The case (locked) and a fresh copy of an operator work item the user may perform,
+    the case and the user it is claimed by attached."""
     from hrc.cases.selectors import performable_by
 
     case = lock_case(item.case_id)
@@ -670,6 +671,10 @@ def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:
         raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
     if not item.performable:
         raise NotAllowed(f"{item.label} is not offered to you.")
+    # What the caller hands back (the API's answer) reads these; they are in hand.
+    item.case = case
+    if item.claimed_by_id == user.pk:
+        item.claimed_by = user
     return case, item
 
 

@@ -153,6 +153,8 @@ class WorkItemSerializer(serializers.ModelSerializer[WorkItem]):
 
     @extend_schema_field(JobSerializer(allow_null=True))
     def get_job(self, item: WorkItem) -> dict[str, Any] | None:
+        if item.kind == WorkItemKind.OPERATOR:
+            return None  # an operator's task never has one: no query to find out
         job = getattr(item, "job", None)
         if job is None:
             return None

@@ -143,6 +143,20 @@ def test_an_operator_claims_starts_and_completes_a_task_and_the_case_moves_on(
     assert sorted(_tasks(operator_client)) == ["fix", "rework"]
 
 
+@pytest.mark.parametrize("action", ["claim", "start", "complete"])
+def test_an_actions_answer_is_the_work_item_as_read_afterwards(
+    operator_client: APIClient, choice_case: Case, action: str
+) -> None:
+    # The answer is built from the service's copy, not read again: it must not differ.
+    item = factories.open_work_item(choice_case, "count")
+    steps = ["claim", "start", "complete"]
+    for earlier in steps[: steps.index(action)]:
+        _act(operator_client, item, earlier)
+    answer = _act(operator_client, item, action, {"data": {"count": 3}})
+    assert answer.status_code == 200, answer.data
+    assert answer.data == operator_client.get(f"/api/work-items/{item.pk}/").data
+
+
 def test_unclaim_gives_the_task_back(
     operator_client: APIClient, choice_case: Case, colleague: User, engineer: User
 ) -> None:
