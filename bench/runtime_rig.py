@@ -1,8 +1,8 @@
 """The case runtime bench's rig: what its measurements share (bench/runtime.py runs them).
 
 A scratch PostgreSQL database, a private redis-server, real Celery workers,
-simulated OPC UA gateways at time scale 0, the API served over HTTP from a
-thread, an OPC UA observer, and the bare Celery app whose worker is the
+simulated OPC UA gateways at time scale 0, the API served over HTTP by
+daphne, an OPC UA observer, and the bare Celery app whose worker is the
 dispatch floor. Nothing at module level imports Django or hrc: the floor
 worker imports this module.
 """
@@ -283,47 +283,80 @@ class Observer:
 
 
 class ApiServer:
-    """Django's WSGI application on 127.0.0.1 (wsgiref, one thread) and a JSON client for it."""
+    """The web process as production runs it (daphne, ASGI) on 127.0.0.1, and a JSON client.
 
-    def __init__(self) -> None:
-        from wsgiref.simple_server import WSGIRequestHandler, make_server
+    A process of its own: served from a thread of the bench, the request
+    would hold the GIL that the observer needs to note the register's
+    change, and what is timed would include the bench's own waiting.
+    """
 
-        from django.core.wsgi import get_wsgi_application
+    def __init__(self, workdir: Path, environment: Mapping[str, str]) -> None:
+        from hrc.cobots.gateway.launcher import free_port
 
-        class Quiet(WSGIRequestHandler):
-            def log_message(self, format: str, *args: Any) -> None:
-                pass  # a line per request would bury the table
+        self.port = free_port()
+        self.log = workdir / "daphne.log"
+        self._environment = {**os.environ, **environment, "PYTHONUNBUFFERED": "1"}
+        self._process: subprocess.Popen[bytes] | None = None
 
-        self._server = make_server("127.0.0.1", 0, get_wsgi_application(), handler_class=Quiet)
-        self._thread = threading.Thread(target=self._server.serve_forever, daemon=True)
-
-    def start(self) -> Self:
-        self._thread.start()
-        return self
+    def start(self, timeout: float = 60.0) -> Self:
+        command = [
+            sys.executable, "-m", "daphne", "--verbosity", "0",
+            "--bind", "127.0.0.1", "--port", str(self.port), "hrc.asgi:application",
+        ]  # fmt: skip
+        with self.log.open("ab") as output:
+            self._process = subprocess.Popen(
+                command, cwd=ROOT, env=self._environment, stdout=output, stderr=subprocess.STDOUT
+            )
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self._process.poll() is not None:
+                raise RuntimeError(f"daphne exited:\n{self.log.read_text()[-4000:]}")
+            with contextlib.suppress(OSError):
+                socket.create_connection(("127.0.0.1", self.port), timeout=1).close()
+                return self
+            time.sleep(0.1)
+        self.stop()
+        raise RuntimeError(f"daphne did not listen within {timeout:.0f} s")
 
     def connect(self) -> http.client.HTTPConnection:
         """An open connection, so that a timed request does not pay for the TCP handshake."""
-        connection = http.client.HTTPConnection("127.0.0.1", self._server.server_port, timeout=30)
+        connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=30)
         connection.connect()
         return connection
 
     def post(
         self, path: str, body: Mapping[str, Any], token: str = "", connection: Any = None
     ) -> tuple[int, Any]:
+        return self.request("POST", path, body, token, connection)
+
+    def request(
+        self,
+        method: str,
+        path: str,
+        body: Mapping[str, Any] | None = None,
+        token: str = "",
+        connection: Any = None,
+    ) -> tuple[int, Any]:
+        """The status and the JSON answer; `connection` (from `connect`) is used and closed."""
         connection = connection or self.connect()
         headers = {"Content-Type": "application/json"}
         if token:
             headers["Authorization"] = f"Token {token}"
         try:
-            connection.request("POST", path, json.dumps(body), headers)
+            connection.request(method, path, None if body is None else json.dumps(body), headers)
             response = connection.getresponse()
             return response.status, json.loads(response.read() or b"null")
         finally:
             connection.close()
 
     def stop(self) -> None:
-        self._server.shutdown()
-        self._server.server_close()
+        if self._process is not None and self._process.poll() is None:
+            self._process.terminate()
+            try:
+                self._process.wait(10)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                self._process.wait(10)
 
 
 class FloorWorker:
@@ -420,7 +453,10 @@ def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
         gateways: list[GatewayProcess] = []
         stack.callback(_stop_all, gateways)
         made = _populate(workdir, settings.cobots, gateways)
-        api = ApiServer().start()
+        api = ApiServer(workdir, {
+            "DJANGO_SETTINGS_MODULE": SETTINGS_MODULE, "DATABASE_URL": database_url,
+            "REDIS_URL": redis.url,
+        }).start()  # fmt: skip
         stack.callback(api.stop)
         status, body = api.post("/api/token/", made.pop("credentials"))
         if status != 200:
