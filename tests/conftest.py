@@ -3,7 +3,8 @@
 The home organisation has an operator, an engineer and an admin. The
 outsider is an engineer of another organisation: able to write at home, so
 a 404 on our objects shows the wall, not a missing role. The loner belongs
-to no organisation.
+to no organisation. The cobot and the case waiting for it serve the runtime's
+pages and API.
 """
 
 import pytest
@@ -11,7 +12,9 @@ from django.contrib.auth.models import User
 from django.test import Client
 from rest_framework.test import APIClient
 
+from hrc.cases import services
 from hrc.cases.models import Case
+from hrc.cobots.models import Cobot
 from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
@@ -122,3 +125,23 @@ def choice_case(choice_version: PatternVersion, engineer: User, operator: User) 
     return factories.make_case(
         choice_version, started_by=engineer, actor_mapping={"o": {"users": [operator.pk]}}
     )
+
+
+@pytest.fixture
+def cobot(organisation: Organisation) -> Cobot:
+    return factories.make_cobot(organisation)
+
+
+@pytest.fixture
+def step_case(organisation: Organisation, engineer: User, operator: User, cobot: Cobot) -> Case:
+    """A hand-over case: the operator has prepared the workpiece, the cobot step is queued."""
+    version = factories.make_version(organisation, published_by=engineer)
+    case = factories.make_case(
+        version,
+        started_by=engineer,
+        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+    )
+    item = factories.open_work_item(case, "to1")
+    services.start_work_item(item, user=operator)
+    services.complete_work_item(item, user=operator)
+    return case

@@ -22,9 +22,7 @@ from hrc.cases import services
 from hrc.cases.choices import CaseStatus, JobState
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
-from hrc.cobots.models import Cobot
 from hrc.organisations.choices import Role
-from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import cobot_chain, shared_space
 
@@ -96,26 +94,6 @@ def test_an_engineer_follows_a_running_case_on_its_net_and_timeline(
     expect(page.locator("#case-data")).to_contain_text('"count": 3')
     expect(page.locator("#work-items")).to_contain_text("fix by hand")
     screenshot(page, "supervisor-case-moved-on")
-
-
-@pytest.fixture
-def cobot(organisation: Organisation) -> Cobot:
-    return factories.make_cobot(organisation)
-
-
-@pytest.fixture
-def step_case(organisation: Organisation, engineer: User, operator: User, cobot: Cobot) -> Case:
-    """A hand-over case: the workpiece is prepared, the cobot's step is queued."""
-    version = factories.make_version(organisation, published_by=engineer)
-    case = factories.make_case(
-        version,
-        started_by=engineer,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
-    )
-    item = factories.open_work_item(case, "to1")
-    services.start_work_item(item, user=operator)
-    services.complete_work_item(item, user=operator)
-    return case
 
 
 def test_an_engineer_skips_a_failed_step_with_its_outputs(

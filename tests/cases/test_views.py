@@ -36,26 +36,6 @@ def _client(user: User) -> Client:
 
 
 @pytest.fixture
-def cobot(organisation: Organisation) -> Cobot:
-    return factories.make_cobot(organisation)
-
-
-@pytest.fixture
-def step_case(organisation: Organisation, engineer: User, operator: User, cobot: Cobot) -> Case:
-    """A hand-over case: the operator has prepared the workpiece, the cobot step is queued."""
-    version = factories.make_version(organisation, published_by=engineer)
-    case = factories.make_case(
-        version,
-        started_by=engineer,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
-    )
-    item = factories.open_work_item(case, "to1")
-    services.start_work_item(item, user=operator)
-    services.complete_work_item(item, user=operator)
-    return case
-
-
-@pytest.fixture
 def incident(step_case: Case) -> Incident:
     return factories.make_incident(factories.open_work_item(step_case, "tc1"), "Protective stop")
 

@@ -3,36 +3,11 @@
 from typing import Any
 
 import pytest
-from django.contrib.auth.models import User
 from rest_framework.test import APIClient
 
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.models import Case, Incident
-from hrc.cobots.models import Cobot
-from hrc.organisations.models import Organisation
 from tests import factories
-
-
-@pytest.fixture
-def cobot(organisation: Organisation) -> Cobot:
-    return factories.make_cobot(organisation)
-
-
-@pytest.fixture
-def step_case(organisation: Organisation, engineer: User, operator: User, cobot: Cobot) -> Case:
-    """A hand-over case whose operator task is done and whose cobot step is queued."""
-    version = factories.make_version(organisation, published_by=engineer)
-    case = factories.make_case(
-        version,
-        started_by=engineer,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
-    )
-    client = APIClient()
-    client.force_authenticate(operator)
-    item = factories.open_work_item(case, "to1")
-    client.post(f"/api/work-items/{item.pk}/start/")
-    assert client.post(f"/api/work-items/{item.pk}/complete/").status_code == 200
-    return case
 
 
 @pytest.fixture
