@@ -18,13 +18,14 @@ from hrc.cases.choices import (
     CaseStatus,
     EventType,
     IncidentKind,
+    InterruptionMode,
     JobState,
     Resolution,
     WorkItemKind,
     WorkItemState,
 )
 from hrc.cases.messages import DEFAULT_TTL_SECONDS, MAX_TTL_SECONDS
-from hrc.cases.models import Case, CaseEvent, Incident, Job, Message, WorkItem
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, Message, WorkItem
 from hrc.cases.nets import case_net
 from hrc.organisations.api.serializers import MemberOrganisationField
 from hrc.patterns.models import PatternVersion
@@ -347,6 +348,47 @@ class CaseEventSerializer(serializers.ModelSerializer[CaseEvent]):
             "detail",
         ]
         read_only_fields = fields
+
+
+class InterruptionSerializer(serializers.ModelSerializer[Interruption]):
+    """A cobot task paused or slowed while an operator worked in the area they share."""
+
+    task = serializers.CharField(source="work_item.task", read_only=True)
+    operator_task = serializers.CharField(source="operator_work_item.task", read_only=True)
+    cobot_name = serializers.CharField(source="cobot.name", read_only=True)
+    mode = EnumField(InterruptionMode)
+    seconds = serializers.SerializerMethodField(
+        help_text="How long the operator was in the area; null while they still are."
+    )
+    settled = serializers.BooleanField(
+        read_only=True, help_text="Over, and the cobot no longer paused by it."
+    )
+
+    class Meta:
+        model = Interruption
+        fields = [
+            "id",
+            "work_item",
+            "task",
+            "operator_work_item",
+            "operator_task",
+            "cobot",
+            "cobot_name",
+            "mode",
+            "started_at",
+            "ended_at",
+            "seconds",
+            "paused_at",
+            "resumed_at",
+            "settled",
+            "error",
+        ]
+        read_only_fields = fields
+
+    def get_seconds(self, interruption: Interruption) -> float | None:
+        if interruption.ended_at is None:
+            return None
+        return round((interruption.ended_at - interruption.started_at).total_seconds(), 3)
 
 
 class ActorMappingSerializer(serializers.Serializer[PatternVersion]):

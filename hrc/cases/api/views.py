@@ -32,6 +32,7 @@ from hrc.cases.api.serializers import (
     CaseSummarySerializer,
     CompleteRequestSerializer,
     IncidentSerializer,
+    InterruptionSerializer,
     MessageRequestSerializer,
     MessageSerializer,
     QueuedJobSerializer,
@@ -43,7 +44,7 @@ from hrc.cases.api.serializers import (
 )
 from hrc.cases.choices import CaseStatus, WorkItemKind
 from hrc.cases.messages import receive_message
-from hrc.cases.models import Case, CaseEvent, Incident, Job, WorkItem
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.organisations.selectors import may_write_in
 from hrc.patterns.models import PatternVersion
 from hrc.patterns.selectors import versions_visible_to
@@ -160,6 +161,14 @@ class CaseViewSet(mixins.ListModelMixin, mixins.RetrieveModelMixin, viewsets.Gen
         # The viewset's model is Case; this action pages another model's rows.
         page: list[CaseEvent] = self.paginate_queryset(events)  # type: ignore[arg-type,assignment]
         return self.get_paginated_response(CaseEventSerializer(page, many=True).data)
+
+    @extend_schema(responses={200: InterruptionSerializer(many=True), **REFUSED_404})
+    @action(detail=True, methods=["get"])
+    def interruptions(self, request: Request, pk: str | None = None) -> Response:
+        """The case's space-constraint interruptions in the order they began, with durations."""
+        interruptions = selectors.interruptions_of(self.get_object())
+        page: list[Interruption] = self.paginate_queryset(interruptions)  # type: ignore[arg-type,assignment]
+        return self.get_paginated_response(InterruptionSerializer(page, many=True).data)
 
     def _detail(self, case: Case) -> Any:
         user = self.request.user
