@@ -50,6 +50,7 @@ from bench.runtime_rig import (
     RESULTS_DIR,
     SETTLE_SECONDS,
     SIGNAL_SHAPE,
+    STEP,
     TARGET_CASES_PER_SECOND,
     TARGET_P50_MS,
     TARGET_P99_MS,
@@ -256,17 +257,79 @@ def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 
 
 
 def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
+    bench.use_workers(0)
+    progress(f"throughput floors: {settings.cases} bare Celery tasks, {settings.cases} bare steps ...")  # fmt: skip
+    floors = {
+        "celery_tasks_per_second": _celery_rate(bench, settings.cases),
+        "steps_per_second": _step_rate(bench, settings.cases),
+    }
     rows = []
     for count in settings.workers:
         progress(f"throughput: {settings.cases} cases, {len(bench.cobots)} cobots, {count} worker(s) ...")  # fmt: skip
         rows.append(_throughput_row(bench, settings.cases, count))
+    for row in rows:
+        row["ratio_to_floors"] = {
+            name: round(row["cases_per_second"] / rate, 3) for name, rate in floors.items()
+        }
     return {
         "pattern": SIGNAL_SHAPE,
         "cobots": len(bench.cobots),
+        "floors": floors,
         "rows": rows,
         "target_cases_per_second": TARGET_CASES_PER_SECOND,
         "meets_target": max(row["cases_per_second"] for row in rows) >= TARGET_CASES_PER_SECOND,
     }
+
+
+def _celery_rate(bench: Rig, count: int) -> float:
+    """Bare Celery tasks per second: `count` no-op tasks queued, then one floor worker (hrc's
+    options) takes them all; from the first task's start to the last's (their own clocks).
+
+    Each case of (b) needs at least one such task.
+    """
+    import redis
+
+    client = redis.Redis.from_url(bench.redis.url)
+    floor_app.conf.broker_url = bench.redis.url
+    key = f"bench-rate-{uuid.uuid4().hex}"
+    for _ in range(count):
+        note_start.apply_async((key,))
+    worker = FloorWorker(bench.workdir, bench.redis.url).start()
+    try:
+        deadline = time.monotonic() + 600
+        while client.llen(key) < count:
+            if time.monotonic() > deadline:
+                raise RuntimeError("The floor worker did not run its tasks within 10 minutes.")
+            time.sleep(0.05)
+    finally:
+        worker.stop()
+    starts = sorted(float(value) for value in client.lrange(key, 0, -1))
+    client.delete(key)
+    return round((count - 1) / (starts[-1] - starts[0]), 1)
+
+
+def _step_rate(bench: Rig, count: int) -> float:
+    """Zero-time steps per second through one driver to one simulated cobot, one after another.
+
+    Each case of (b) runs one such step; the driver is hrc's (the four-phase
+    handshake with its fencing token), called from this process, nothing else around it.
+    """
+    from hrc.cobots.drivers.base import Fence, StepCommand
+    from hrc.cobots.drivers.runner import driver_for
+
+    gateway, cobot = bench.gateways[0], bench.cobots[0]
+    driver = driver_for(cobot.name, gateway.endpoint, step_timeout=30.0)
+    try:
+        steps = [StepCommand(step=STEP, fence=Fence(FLOOR_VALUES_FROM + n)) for n in range(count)]
+        driver.run_step(steps[0])  # the session and its subscription
+        started = time.perf_counter()
+        for step in steps[1:]:
+            result = driver.run_step(step)
+            if result.outcome != "ran":
+                raise RuntimeError(f"A bare step answered {result.outcome!r}.")
+        return round((count - 1) / (time.perf_counter() - started), 1)
+    finally:
+        driver.close()
 
 
 def _throughput_row(bench: Rig, cases: int, workers: int) -> dict[str, Any]:
@@ -544,6 +607,11 @@ def print_table(report: Mapping[str, Any]) -> None:
         print(f"{row['workers']:>4} × {row['concurrency']} {row['cases']:>6} {row['cases_per_second']:>8.1f} "
               f"{row['job_lease_to_end']['p50_ms']:>11.2f} {row['prepare_cases_per_second']:>10.1f} "
               f"{row['db_sessions_opened_per_case']:>9.2f}  {cpu}")  # fmt: skip
+    floors = throughput["floors"]
+    print(f"floor: bare Celery tasks/s, one worker {floors['celery_tasks_per_second']:>10.1f}"
+          f"   ours / floor: {', '.join(str(r['ratio_to_floors']['celery_tasks_per_second']) for r in throughput['rows'])}")  # fmt: skip
+    print(f"floor: zero-time steps/s, one driver   {floors['steps_per_second']:>10.1f}"
+          f"   ours / floor: {', '.join(str(r['ratio_to_floors']['steps_per_second']) for r in throughput['rows'])}")  # fmt: skip
     verdict = "meets" if throughput["meets_target"] else "MISSES"
     print(f"target >= {TARGET_CASES_PER_SECOND:g} cases/s: {verdict}")
 

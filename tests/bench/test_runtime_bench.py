@@ -75,9 +75,12 @@ def test_a_quick_run_writes_the_report_and_leaves_nothing_behind(tmp_path: Path)
     throughput = report["throughput"]
     assert throughput["cobots"] == QUICK["cobots"]
     assert [row["workers"] for row in throughput["rows"]] == [1, 2]
+    assert set(throughput["floors"]) == {"celery_tasks_per_second", "steps_per_second"}
+    assert all(rate > 0 for rate in throughput["floors"].values())
     for row in throughput["rows"]:
         assert row["cases"] == QUICK["cases"]
         assert row["cases_per_second"] > 0
+        assert set(row["ratio_to_floors"]) == set(throughput["floors"])
         assert row["seconds"] > 0
         _positive_summary(row["job_lease_to_end"], n=QUICK["cases"])
 
