@@ -46,6 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from bench import nets
+from bench.report import load_average, write_results
 from hrc.engine.layout import lay_out
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -325,18 +326,12 @@ def run(frames: int, results_dir: Path) -> dict[str, Any]:
             "meets_target": drag["p95_ms"] < TARGET_FRAME_MS,
         },
     }
-    results_dir.mkdir(parents=True, exist_ok=True)
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-    for name in (f"editor-{stamp}.json", "editor-latest.json"):
-        (results_dir / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_results(results_dir, "editor", report)
     return report
 
 
 def machine() -> dict[str, Any]:
-    try:
-        load: list[float] | None = [round(value, 2) for value in os.getloadavg()]
-    except OSError:
-        load = None
+    load = load_average()
     commit = subprocess.run(
         ["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=False
     ).stdout.strip()

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import json
 import os
 import platform
 import statistics
@@ -26,6 +25,8 @@ from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from bench.report import write_results
 
 RESULTS_DIR = Path(__file__).resolve().parent / "results"
 TARGET_P50_MS = 5.0
@@ -110,10 +111,7 @@ def run(steps: int, warmup: int, results_dir: Path) -> dict[str, Any]:
         "meets_target": rows["ours"]["p50_ms"] <= TARGET_P50_MS
         and rows["ours"]["p99_ms"] <= TARGET_P99_MS,
     }
-    results_dir.mkdir(parents=True, exist_ok=True)
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-    for name in (f"handshake-{stamp}.json", "handshake-latest.json"):
-        (results_dir / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_results(results_dir, "handshake", report)
     return report
 
 

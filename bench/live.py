@@ -40,6 +40,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from bench.report import load_average, print_load, write_results
 from bench.runtime_rig import (
     RESULTS_DIR,
     ROOT,
@@ -419,9 +420,9 @@ def measure_floor(bench: Rig, settings: Settings) -> dict[str, Any]:
 
 
 def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
-    from bench.runtime import _load, machine
+    from bench.runtime import machine
 
-    load_before = _load()
+    load_before = load_average()
     with rig(settings, progress) as bench:
         host = machine()
         floor = measure_floor(bench, settings)
@@ -430,7 +431,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "benchmark": "live",
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
-        "load_average": {"before": load_before, "after": _load()},
+        "load_average": {"before": load_before, "after": load_average()},
         "settings": {k: v for k, v in asdict(settings).items() if k != "results_dir"},
         "pattern": SHAPE,
         **ours,
@@ -440,10 +441,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "target_p99_ms": TARGET_P99_MS,
         "meets_target": ours["ours"]["p99_ms"] <= TARGET_P99_MS,
     }
-    settings.results_dir.mkdir(parents=True, exist_ok=True)
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-    for name in (f"live-{stamp}.json", "live-latest.json"):
-        (settings.results_dir / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_results(settings.results_dir, "live", report)
     return report
 
 
@@ -464,9 +462,7 @@ def print_table(report: Mapping[str, Any]) -> None:
           f"holes seen by tablets: {report['holes']}")  # fmt: skip
     verdict = "meets" if report["meets_target"] else "MISSES"
     print(f"target p99 <= {TARGET_P99_MS:g} ms: {verdict}")
-    load, cores = report["load_average"]["before"], report["machine"]["cpu_count"]
-    if load:
-        print(f"load average {load[0]:.2f} on {cores} cores at the start; compare quiet runs only")
+    print_load(report)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> Settings:

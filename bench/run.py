@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.nets import EXPECTED_SOUND, FAMILIES, SIZES, generate, transition_count
+from bench.report import load_average
 from hrc.engine import check_document
 from hrc.engine.document import read_pattern
 from hrc.engine.execution import build_execution_net
@@ -280,14 +281,6 @@ def machine() -> dict[str, Any]:
     return info
 
 
-def _load() -> list[float] | None:
-    """The 1, 5 and 15 minute load averages, where the system has them."""
-    try:
-        return [round(value, 2) for value in os.getloadavg()]
-    except OSError:
-        return None
-
-
 def _cpu_model() -> str | None:
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -426,7 +419,7 @@ def _summary(row: Mapping[str, Any]) -> str:
 def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
     """Measures every net and writes the result files; returns the result document."""
     started = datetime.now(UTC)
-    load_before = _load()
+    load_before = load_average()
     rows = []
     woflan_overran: dict[str, str] = {}
     for size in sorted(settings.sizes):  # small first, so a Woflan timeout can skip larger ones
@@ -445,7 +438,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "machine": machine(),
         # Other work on the machine slows both checkers (Woflan most, as it runs
         # longest); the load average says how quiet the run was.
-        "load_average": {"before": load_before, "after": _load()},
+        "load_average": {"before": load_before, "after": load_average()},
         "settings": {
             "families": settings.families,
             "sizes": sorted(settings.sizes),

@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
-import json
 import os
 import signal
 import subprocess
@@ -42,6 +41,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Self
 
+from bench.report import load_average, print_load, write_results
 from bench.runtime_rig import (
     FLOOR_REGISTER,
     FLOOR_VALUES_FROM,
@@ -531,7 +531,7 @@ def _one_step(case_id: int, user: User) -> float:
 
 
 def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
-    load_before = _load()
+    load_before = load_average()
     with rig(settings, progress) as bench:
         host = machine()  # while the database is there to say its version
         signalling = measure_signalling(bench, settings, progress)
@@ -541,16 +541,13 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "benchmark": "runtime",
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
-        "load_average": {"before": load_before, "after": _load()},
+        "load_average": {"before": load_before, "after": load_average()},
         "settings": {key: value for key, value in asdict(settings).items() if key != "results_dir"},
         "signalling": signalling,
         "throughput": throughput,
         "log_length": log_length,
     }
-    settings.results_dir.mkdir(parents=True, exist_ok=True)
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-    for name in (f"runtime-{stamp}.json", "runtime-latest.json"):
-        (settings.results_dir / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_results(settings.results_dir, "runtime", report)
     return report
 
 
@@ -568,12 +565,6 @@ def machine() -> dict[str, Any]:
     redis = subprocess.run(["redis-server", "--version"], capture_output=True, text=True, check=False)  # fmt: skip
     info["redis_server"] = redis.stdout.strip()
     return info
-
-
-def _load() -> list[float] | None:
-    with contextlib.suppress(OSError):
-        return [round(value, 2) for value in os.getloadavg()]
-    return None
 
 
 def print_table(report: Mapping[str, Any]) -> None:
@@ -621,9 +612,7 @@ def print_table(report: Mapping[str, Any]) -> None:
         events = "–".join(str(row[k]) for k in ("events_before", "events_after") if k in row)
         print(f"{label:12} {events:>12} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f} {row['mean_ms']:8.3f}")  # fmt: skip
     print(f"long / short: p50 {log['ratio_p50']:.2f}, mean {log['ratio_mean']:.2f} (flat is 1)")
-    load, cores = report["load_average"]["before"], report["machine"]["cpu_count"]
-    if load:
-        print(f"load average {load[0]:.2f} on {cores} cores at the start; compare quiet runs only")
+    print_load(report)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> Settings:

@@ -44,6 +44,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from bench.report import load_average, print_load, write_results
 from bench.runtime_rig import (
     RESULTS_DIR,
     ROOT,
@@ -233,12 +234,12 @@ def measure_use_case(
 
 
 def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str, Any]:
-    from bench.runtime import _load, machine
+    from bench.runtime import machine
 
     files = use_case_files(settings.only)
     if not files:
         raise SystemExit(f"No use case matches {settings.only} in {USE_CASES_DIR}.")
-    load_before = _load()
+    load_before = load_average()
     with rig(settings, progress) as workdir:
         host = machine()
         results = [measure_use_case(path, workdir, settings, progress) for path in files]
@@ -246,7 +247,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "benchmark": "use_cases",
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
-        "load_average": {"before": load_before, "after": _load()},
+        "load_average": {"before": load_before, "after": load_average()},
         "settings": {
             key: list(value) if isinstance(value, tuple) else value
             for key, value in asdict(settings).items()
@@ -254,10 +255,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         },
         "use_cases": results,
     }
-    settings.results_dir.mkdir(parents=True, exist_ok=True)
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-    for name in (f"use-cases-{stamp}.json", "use-cases-latest.json"):
-        (settings.results_dir / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_results(settings.results_dir, "use-cases", report)
     return report
 
 
@@ -283,9 +281,7 @@ def print_table(report: Mapping[str, Any]) -> None:
               f"{s['idle_ms_per_task']:8.1f}")  # fmt: skip
     print("busy: the time some task of the case ran (the floor for these task times); "
           "idle = cycle − busy: only hrc at work")  # fmt: skip
-    load, cores = report["load_average"]["before"], report["machine"]["cpu_count"]
-    if load:
-        print(f"load average {load[0]:.2f} on {cores} cores at the start; compare quiet runs only")
+    print_load(report)
 
 
 def parse_args(argv: Sequence[str] | None = None) -> Settings:
