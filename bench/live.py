@@ -4,7 +4,7 @@ on 200 connected tablets, against the channel layer's own floor.
 Everything runs on this machine and is thrown away afterwards: a scratch
 PostgreSQL database, a private redis-server (Celery broker and channel
 layer), one real Celery worker, one simulated OPC UA gateway (TIME_SCALE),
-the ASGI server (daphne's runserver) in its own process, and N WebSocket
+the ASGI server (daphne, as production runs it) in its own process, and N WebSocket
 clients (the `websockets` library) on one asyncio loop in this process, each
 signed in as an operator of its own.
 
@@ -26,14 +26,11 @@ import argparse
 import asyncio
 import contextlib
 import json
-import os
 import signal
-import subprocess
 import sys
 import tempfile
 import threading
 import time
-import urllib.request
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from datetime import UTC, datetime
@@ -43,8 +40,8 @@ from typing import Any
 from bench.report import load_average, print_load, write_results
 from bench.runtime_rig import (
     RESULTS_DIR,
-    ROOT,
     SETTINGS_MODULE,
+    ApiServer,
     Observer,
     _set_up_django,
     database_server,
@@ -195,45 +192,6 @@ class Tablets:
 # The rig --------------------------------------------------------------------------------------
 
 
-class Server:
-    """daphne's runserver on the scratch database and the private Redis."""
-
-    def __init__(self, workdir: Path, environment: Mapping[str, str]) -> None:
-        from hrc.cobots.gateway.launcher import free_port
-
-        self.port = free_port()
-        self.log = workdir / "server.log"
-        self.environment = dict(environment)
-        self.process: subprocess.Popen[bytes] | None = None
-
-    def start(self) -> Server:
-        with self.log.open("wb") as output:
-            self.process = subprocess.Popen(
-                [sys.executable, "manage.py", "runserver", "--noreload", "--insecure",
-                 f"127.0.0.1:{self.port}"],
-                cwd=ROOT, env={**os.environ, **self.environment}, stdout=output,
-                stderr=subprocess.STDOUT,
-            )  # fmt: skip
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            if self.process.poll() is not None:
-                raise RuntimeError(f"the server exited:\n{self.log.read_text()}")
-            with contextlib.suppress(OSError):
-                urllib.request.urlopen(f"http://127.0.0.1:{self.port}/accounts/login/", timeout=1)
-                return self
-            time.sleep(0.1)
-        raise RuntimeError(f"the server did not answer:\n{self.log.read_text()}")
-
-    def stop(self) -> None:
-        if self.process is not None and self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-        self.process = None
-
-
 @dataclass
 class Rig:
     organisation: Any
@@ -267,7 +225,7 @@ def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
         worker = WorkerProcess(workdir, name="worker0", environment=environment, beat=True)
         worker.start()
         stack.callback(worker.stop)
-        server = Server(workdir, environment).start()
+        server = ApiServer(workdir, environment).start()  # the runtime bench's web process
         stack.callback(server.stop)
         progress(f"{settings.clients} tablets connecting")
         url = f"ws://127.0.0.1:{server.port}/ws/live/?organisation={made['organisation'].pk}"

@@ -283,7 +283,8 @@ class Observer:
 
 
 class ApiServer:
-    """The web process as production runs it (daphne, ASGI) on 127.0.0.1, and a JSON client.
+    """The web process as production runs it (daphne, ASGI) on 127.0.0.1, and a JSON client;
+    the live bench's server too (its tablets' WebSockets).
 
     A process of its own: served from a thread of the bench, the request
     would hold the GIL that the observer needs to note the register's
