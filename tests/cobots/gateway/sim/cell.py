@@ -201,11 +201,12 @@ class Cell:
 
     async def moving(self) -> None:
         """Returns once the arm is moving."""
-        await self.recorder.wait_for("Axes/ActualVelocities/AxisVelocities", _nonzero)
+        await self.recorder.wait_for("Axes/ActualVelocities/AxisVelocities", is_moving)
 
     async def close(self) -> None:
         await self.backend.close()
 
 
-def _nonzero(value: Value) -> bool:
-    return isinstance(value, list) and any(abs(float(v)) > 1e-6 for v in value)
+def is_moving(velocities: Value) -> bool:
+    """True for joint velocities of an arm in motion."""
+    return isinstance(velocities, list) and any(abs(float(v)) > 1e-6 for v in velocities)

@@ -9,7 +9,7 @@ from hrc.cobots import urua
 from hrc.cobots.gateway.backend import CommandFailed
 from hrc.cobots.gateway.sim import kinematics, programs
 from hrc.cobots.gateway.sim.kinematics import HOME, pose_trans
-from tests.cobots.gateway.sim.cell import ZERO_POSE, Ack, Cell, out
+from tests.cobots.gateway.sim.cell import ZERO_POSE, Ack, Cell, is_moving, out
 
 POSITION_TOLERANCE = 1e-5  # metres
 ROTATION_TOLERANCE = 1e-5  # radians
@@ -94,9 +94,11 @@ async def test_each_program_moves_the_arm_to_its_targets(cell: Cell, case: Case)
         case.step, workspace=case.workspace, pose=case.pose, second_pose=case.second_pose
     )
     assert ack.outcome == urua.OUTCOME_RAN
-    joints_on_the_way = cell.recorder.since(mark, "Axes/ActualPositions/AxisPositions")
-    # It moved over time: positions between the endpoints were published.
-    assert len({tuple(q) for q in joints_on_the_way}) >= 4  # type: ignore[arg-type]
+    # It moved over time rather than jumping: every motion sample carries the
+    # velocity since the last one. (Counting intermediate positions instead
+    # depends on the machine: a loaded loop samples a 40 ms move only at its end.)
+    velocities = cell.recorder.since(mark, "Axes/ActualVelocities/AxisVelocities")
+    assert any(is_moving(v) for v in velocities)
     poses = cell.recorder.since(mark, "Tcp/ActualPose/TCPPose")
     for target in case.visits:
         assert reached(cell, target, poses)  # type: ignore[arg-type]
