@@ -42,7 +42,8 @@ demo: install  ## migrate, load the demo people and examples, start two simulate
 $(CHROMIUM):
 	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
 
-test: install $(CHROMIUM)  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1, chromium for the browser tests)
+# The tests take the bench's dependencies too: the XES export is read back by pm4py.
+test: install $(BENCH_STAMP) $(CHROMIUM)  ## run the whole test suite (PostgreSQL and Redis on 127.0.0.1, chromium for the browser tests)
 	@if [ -d frontend/test ]; then cd frontend && npx vitest run; fi
 	$(PY) -m pytest -n 2 -p no:cacheprovider
 

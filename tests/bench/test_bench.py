@@ -1,4 +1,4 @@
-"""The benchmark's generators and a tiny run (no pm4py: tests do not install it)."""
+"""The benchmark's generators and a tiny run (without Woflan: it would start pm4py's machinery)."""
 
 import json
 from pathlib import Path

@@ -138,7 +138,8 @@ def test_bad_parameters_are_a_json_400_that_names_them_whatever_the_client_accep
 def test_a_process_mining_tool_reads_the_log(
     engineer_client: APIClient, shared: PatternVersion, cases: list[Case], tmp_path: Path
 ) -> None:
-    pm4py = pytest.importorskip("pm4py")  # the bench's dependency (requirements/bench-lock.txt)
+    import pm4py  # AGPL, so bench and tests only (requirements/bench-lock.txt); slow to import
+
     _, body = download(engineer_client, f"?version={shared.pk}")
     path = tmp_path / "shared.xes"
     path.write_bytes(body)
