@@ -69,9 +69,10 @@ export default class ContextPadProvider {
   private entry(group: string, title: string, icon: string, run: () => void): Entry {
     const click = () => {
       run();
-      // The pad is outside the canvas and is redrawn for the new selection: give the keys
-      // back to the canvas once that is done, unless a field (a new task's label) took them.
-      setTimeout(() => this.canvas.restoreFocus());
+      // Pressing on the pad (outside the canvas, not focusable) left the focus on the page:
+      // give the keys back to the canvas now, unless a field (a new task's label) took them.
+      // Not on a timer: the browser handles a key pressed right after the click before timers.
+      if (document.activeElement === document.body) this.canvas.focus();
     };
     return { group, title, html: entryHtml(icon), action: { click } };
   }
