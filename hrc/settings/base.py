@@ -47,6 +47,7 @@ MIDDLEWARE = [
     "django.contrib.auth.middleware.AuthenticationMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
+    "hrc.middleware.DatabaseUnavailableMiddleware",
 ]
 
 ROOT_URLCONF = "hrc.urls"
@@ -80,7 +81,8 @@ if DATABASE_URL:
         DATABASES["default"].setdefault("OPTIONS", {})["pool"] = {
             "min_size": 1,
             "max_size": int(env_str("HRC_DB_POOL_SIZE") or 10),
-            "timeout": 10,
+            # How long a request waits for a free connection before it answers 503.
+            "timeout": float(env_str("HRC_DB_POOL_TIMEOUT") or 10),
         }
 else:
     # The embedded default: one file under var/, created by `migrate`.

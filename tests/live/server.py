@@ -1,4 +1,4 @@
-"""A real ASGI server (daphne's runserver) on the test database, which a test may stop and start.
+"""A real ASGI server (daphne's runserver, or daphne) on the test database, which a test may stop and start.
 
 The browser fixtures keep one for the whole session; the live tests need
 their own too: one on a private broker beside Celery workers, one that is
@@ -12,7 +12,7 @@ import subprocess
 import sys
 import time
 import urllib.request
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Self
 
@@ -32,7 +32,9 @@ class _ManagePy:
         self.environment = dict(environment or {})
         self.process: subprocess.Popen[bytes] | None = None
 
-    def _spawn(self, *arguments: str) -> subprocess.Popen[bytes]:
+    def _spawn(
+        self, *arguments: str, program: Sequence[str] = ("manage.py",)
+    ) -> subprocess.Popen[bytes]:
         database = connection.settings_dict
         environment = {
             **os.environ,
@@ -44,7 +46,7 @@ class _ManagePy:
         }
         with self.log.open("ab") as output:
             self.process = subprocess.Popen(
-                [sys.executable, "manage.py", *arguments],
+                [sys.executable, *program, *arguments],
                 cwd=settings.BASE_DIR, env=environment, stdout=output, stderr=subprocess.STDOUT,
             )  # fmt: skip
         return self.process
@@ -73,8 +75,14 @@ class LiveServer(_ManagePy):
     def ws_url(self) -> str:
         return f"ws://127.0.0.1:{self.port}"
 
-    def start(self, timeout: float = 30.0) -> Self:
-        process = self._spawn("runserver", "--noreload", "--insecure", f"127.0.0.1:{self.port}")
+    def start(self, timeout: float = 30.0, *, bare: bool = False) -> Self:
+        """runserver, or with `bare` daphne itself as production runs it: no static files,
+        and no migration check at start-up (which needs the database)."""
+        if bare:
+            arguments = ("-b", "127.0.0.1", "-p", str(self.port), "hrc.asgi:application")
+            process = self._spawn(*arguments, program=("-m", "daphne"))
+        else:
+            process = self._spawn("runserver", "--noreload", "--insecure", f"127.0.0.1:{self.port}")
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if process.poll() is not None:
