@@ -80,10 +80,7 @@ class Lease:
 
 def run_next_job(job_id: int) -> None:
     """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
-    cobot_id = Job.objects.filter(pk=job_id).values_list("cobot_id", flat=True).first()
-    if cobot_id is None:
-        return
-    lease = lease_next_job(cobot_id)
+    lease = _lease_next(Q(jobs__pk=job_id))
     if lease is None:
         return
     try:
@@ -100,6 +97,11 @@ def lease_next_job(cobot_id: int) -> Lease | None:
     Starting the job's task (its `start` firing) happens here, in the same
     transaction: the cobot taking the job is the moment the task starts.
     """
+    return _lease_next(Q(pk=cobot_id))
+
+
+def _lease_next(which: Q) -> Lease | None:
+    """`lease_next_job` for the cobot `which` selects (by its own id, or by one of its jobs')."""
     now = timezone.now()
     with transaction.atomic():
         # The lock first, then the reasons to wait in a statement of their own: a statement
@@ -108,7 +110,10 @@ def lease_next_job(cobot_id: int) -> Lease | None:
         # NO KEY: a case service inserting a job or an interruption takes a key-share lock
         # on the cobot row (the foreign key) while it holds its case; FOR UPDATE would
         # wait for it while we wait for the case, a deadlock.
-        Cobot.objects.select_for_update(of=("self",), no_key=True).filter(pk=cobot_id).exists()
+        locked = Cobot.objects.select_for_update(of=("self",), no_key=True).filter(which)
+        cobot_id = locked.values_list("pk", flat=True).first()
+        if cobot_id is None:
+            return None
         busy = Job.objects.filter(cobot=OuterRef("pk"), state=JobState.RUNNING)
         cobot = Cobot.objects.annotate(
             busy=Exists(busy), paused=Exists(_unsettled_interruptions(OuterRef("pk")))
