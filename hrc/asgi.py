@@ -15,8 +15,10 @@ from channels.routing import ProtocolTypeRouter, URLRouter  # noqa: E402
 from channels.security.websocket import AllowedHostsOriginValidator  # noqa: E402
 from django.conf import settings  # noqa: E402
 
+from hrc import urls  # noqa: E402, F401 (loaded now, not on the first request: frozen below)
 from hrc.embedded import EmbeddedServices  # noqa: E402
 from hrc.live.routing import websocket_urlpatterns  # noqa: E402
+from hrc.process import freeze_start_up  # noqa: E402
 
 application = ProtocolTypeRouter(
     {
@@ -28,3 +30,4 @@ application = ProtocolTypeRouter(
 )
 if settings.HRC_INLINE_TASKS:  # no Redis: the sweeper and the cobot monitor run in this server
     application = EmbeddedServices(application)
+freeze_start_up()

@@ -4,7 +4,7 @@ import os
 from typing import Any
 
 from celery import Celery
-from celery.signals import task_postrun, task_prerun
+from celery.signals import task_postrun, task_prerun, worker_process_init, worker_ready
 
 os.environ.setdefault("DJANGO_SETTINGS_MODULE", "hrc.settings.dev")
 
@@ -29,3 +29,15 @@ def _close_old_connections(task: Any = None, **kwargs: Any) -> None:
 
 task_prerun.connect(_close_old_connections)
 task_postrun.connect(_close_old_connections)
+
+
+def _freeze_start_up(**kwargs: Any) -> None:
+    """The worker's main process, which takes the messages from the broker, once ready, and
+    each pool child once forked and set up (hrc/process.py)."""
+    from hrc.process import freeze_start_up
+
+    freeze_start_up()
+
+
+worker_process_init.connect(_freeze_start_up)
+worker_ready.connect(_freeze_start_up)

@@ -18,6 +18,7 @@ from django.core.management.base import BaseCommand, CommandError, CommandParser
 from hrc.cobots.gateway.backend import Backend, CommandFailed
 from hrc.cobots.gateway.server import Gateway, GatewayError
 from hrc.cobots.pki import PkiError, check_cobot_name, is_loopback, secure_server
+from hrc.process import freeze_start_up
 
 BACKENDS = ("sim", "ur-rtde")
 
@@ -93,6 +94,7 @@ class Command(BaseCommand):
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.add_signal_handler(sig, stop.set)
         await gateway.start()
+        freeze_start_up()
         try:
             self.stdout.write(f"{gateway.name} gateway serving {gateway.endpoint}")
             self.stdout.flush()

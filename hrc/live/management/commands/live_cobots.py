@@ -7,6 +7,7 @@ from typing import Any
 from django.core.management.base import BaseCommand, CommandParser
 
 from hrc.live.monitor import Monitor
+from hrc.process import freeze_start_up
 
 
 class Command(BaseCommand):
@@ -29,5 +30,6 @@ class Command(BaseCommand):
         monitor = Monitor(options["organisation"], options["interval"])
         self.stdout.write("live monitor watching cobots", ending="\n")
         self.stdout.flush()
+        freeze_start_up()
         with contextlib.suppress(KeyboardInterrupt):
             asyncio.run(monitor.run())
