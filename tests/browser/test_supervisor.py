@@ -33,6 +33,9 @@ Screenshot = Callable[[Page, str], Path]
 # With its live socket up a page reads the API when a delta rings, and polls only every
 # 30 s (frontend/src/supervisor/model.ts): a change shown within LIVE came by the socket.
 LIVE = 10_000
+# The cobot's steps run this many times slower until a test has done what must happen
+# mid-step: a ~1 s pick could otherwise end first on a loaded machine (signing in takes time).
+SLOWDOWN = "4"
 
 
 def _until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
@@ -182,6 +185,7 @@ def test_an_engineer_retries_a_step_after_a_protective_stop_and_sees_the_case_fi
     with Simulation(cobot_chain(steps=1, timeout=30), tmp_path, time_scale=0.5) as simulation:
         engineer = factories.make_member(simulation.organisation, Role.ENGINEER, "eve-engineer")
         cobot = simulation.cobot("c")
+        cobot.call("Simulator/InjectFault", "slow-steps", SLOWDOWN)  # stopped mid-step, surely
         with simulation.running(operators=False):
             [case_id] = simulation.start_cases(1)
             case = Case.objects.get(pk=case_id)
@@ -191,6 +195,7 @@ def test_an_engineer_retries_a_step_after_a_protective_stop_and_sees_the_case_fi
             _until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
             cobot.call("Simulator/InjectFault", "protective-stop", "")
             incident = _until(lambda: Incident.objects.filter(case=case).first())
+            cobot.call("Simulator/ClearFault")  # the slowdown; the stop stays for a person
 
             sign_in(page, engineer)
             page.goto(f"{live_url}/cases/{case_id}/")
@@ -222,6 +227,7 @@ def test_an_interruption_shows_while_an_operator_works_in_the_shared_area(
     with Simulation(shared_space(), tmp_path, time_scale=0.5) as simulation:
         engineer = factories.make_member(simulation.organisation, Role.ENGINEER, "eve-engineer")
         operator = simulation.users["o"]
+        simulation.cobot("c").call("Simulator/InjectFault", "slow-steps", SLOWDOWN)
         with simulation.running(operators=False):
             [case_id] = simulation.start_cases(1)
             case = Case.objects.get(pk=case_id)
@@ -237,6 +243,7 @@ def test_an_interruption_shows_while_an_operator_works_in_the_shared_area(
             services.start_work_item(inspect, user=operator)
             interruptions = page.locator("#interruptions")
             expect(interruptions).to_contain_text("(ongoing)", timeout=LIVE)
+            simulation.cobot("c").call("Simulator/ClearFault")
             expect(interruptions).to_contain_text("inspect")
             expect(interruptions).to_contain_text("Pause")
             expect(page.locator('svg.net [data-task="to2"]')).to_have_attribute(

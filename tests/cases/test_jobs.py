@@ -71,6 +71,9 @@ def test_an_operator_in_the_shared_area_pauses_the_running_cobot_until_done(
     simulation: Simulation,
 ) -> None:
     cobot = simulation.cobot("c")
+    # The pick slowed down until the pause: on a loaded machine the operator's start could
+    # otherwise come after a pick of ~1 s had ended (4 s now), and there would be nothing to pause.
+    cobot.call("Simulator/InjectFault", "slow-steps", "4")
     with simulation.running(operators=False):
         [case_id] = simulation.start_cases(1)
         case = Case.objects.get(pk=case_id)
@@ -78,6 +81,7 @@ def test_an_operator_in_the_shared_area_pauses_the_running_cobot_until_done(
         until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
         inspect = _do(simulation, case, "to2")
         until(lambda: cobot.read(urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PAUSED)
+        cobot.call("Simulator/ClearFault")
         time.sleep(0.3)
         assert Job.objects.get(case=case).state == JobState.RUNNING  # held, not failed
         services.complete_work_item(inspect, user=simulation.users["o"])
