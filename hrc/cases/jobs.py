@@ -20,6 +20,7 @@ import datetime as dt
 import logging
 import os
 import socket
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -80,15 +81,22 @@ class Lease:
 
 def run_next_job(job_id: int) -> None:
     """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
-    lease = _lease_next(Q(jobs__pk=job_id))
-    if lease is None:
-        return
+    # The cobot first, the tablets right after: what taking the job broadcasts (its task
+    # started, the queue) waits until the cobot has accepted the step (hrc/live/broadcast.py).
+    hold = live.hold()
     try:
-        result = _execute(lease)
-    except DriverError as error:
-        fail_job(lease, error)
-    else:
-        finish_job(lease, result)
+        lease = _lease_next(Q(jobs__pk=job_id))
+        if lease is None:
+            return
+        try:
+            result = _execute(lease, on_sent=hold.release)
+        except DriverError as error:
+            hold.release()
+            fail_job(lease, error)
+        else:
+            finish_job(lease, result)
+    finally:
+        hold.release()
 
 
 def lease_next_job(cobot_id: int) -> Lease | None:
@@ -193,17 +201,19 @@ def _unsettled_interruptions(cobot: Cobot | OuterRef) -> Any:
     )
 
 
-def _execute(lease: Lease) -> dict[str, Any]:
+def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
+    """Drives the job; `on_sent` is called once its step is accepted, or before a device call."""
     driver = driver_for_cobot(lease.cobot, step_timeout=lease.timeout)
     command = lease.command
     if lease.kind == WorkItemKind.DEVICE:
+        on_sent()  # a call (an inspection, say) may take a while: tablets need not wait for it
         return _call_device(driver, lease)
     _prepare(driver, lease.cobot.pk, command["program"], lease.timeout)
     step = StepCommand(
         step=command["number"], fence=Fence(lease.job_id, lease.attempt),
         workspace=command["workspace"], poses=command["poses"],
     )  # fmt: skip
-    result = driver.run_step(step, timeout=lease.timeout)
+    result = driver.run_step(step, timeout=lease.timeout, on_sent=on_sent)
     if result.outcome not in ("ran", "duplicate"):
         raise CommandRefused(
             f"{lease.cobot.name}'s program answered step {step.step} of {command['program']} "

@@ -20,6 +20,11 @@ sender puts what one batch holds for the same groups (a commit's deltas and
 the queues it changed) in one message, encoded once: 200 tablets cost 200
 frames per commit, not 200 frames and JSON encodings per delta. The
 consumer re-checks each message against the socket's user before sending.
+
+A worker `hold`s the sender while it takes a job, until the cobot has
+accepted the step: the sender's work (a query, JSON, Redis) would otherwise
+compete for the process's GIL with the write that moves the cobot. A hold
+delays the tablets by HOLD_LIMIT at most.
 """
 
 from __future__ import annotations
@@ -53,6 +58,8 @@ CHANNEL_MESSAGE_TYPE = "live.events"
 FLUSH_TIMEOUT = 10.0
 # The sender keeps its database connection (for the cobot queues) while it is busy.
 IDLE_SECONDS = 2.0
+# The longest a hold keeps the sender waiting, released or not.
+HOLD_LIMIT = 0.2
 
 _INCIDENT_EVENTS = frozenset({"incident-opened", "incident-resolved"})
 _CLOSED_ITEM_STATES = frozenset({"completed", "withdrawn"})
@@ -259,11 +266,21 @@ class _Sender:
     def __init__(self) -> None:
         self.queue: queue.SimpleQueue[_Work] = queue.SimpleQueue()
         self.pid = os.getpid()
+        self.holds = 0
+        self.open = threading.Event()  # set while nothing holds the sender
+        self.open.set()
+        self.guard = threading.Lock()
         self.thread = threading.Thread(target=self._run, name="hrc-live-sender", daemon=True)
         self.thread.start()
 
     def put(self, work: _Work) -> None:
         self.queue.put(work)
+
+    def hold(self) -> Hold:
+        with self.guard:
+            self.holds += 1
+            self.open.clear()
+        return Hold(self)
 
     def _run(self) -> None:
         loop = asyncio.new_event_loop()
@@ -274,6 +291,7 @@ class _Sender:
                 # Idle: give the queue reads' connection back (it would keep the database busy).
                 connections.close_all()
                 continue
+            self.open.wait(HOLD_LIMIT)
             while True:  # whatever else is waiting goes in the same batch
                 try:
                     batch.append(self.queue.get_nowait())
@@ -344,6 +362,29 @@ def _run_on_layer(coroutine: Any, own_loop: asyncio.AbstractEventLoop) -> None:
         asyncio.run_coroutine_threadsafe(coroutine, target).result(FLUSH_TIMEOUT)
     else:
         own_loop.run_until_complete(coroutine)
+
+
+class Hold:
+    """Keeps this process's sender from starting a batch until released (see the module's doc)."""
+
+    def __init__(self, sender: _Sender) -> None:
+        self._sender = sender
+        self._released = False
+
+    def release(self) -> None:
+        """Lets the sender go on; any number of calls, from any thread."""
+        sender = self._sender
+        with sender.guard:
+            if self._released:
+                return
+            self._released = True
+            sender.holds -= 1
+            if sender.holds == 0:
+                sender.open.set()
+
+
+def hold() -> Hold:
+    return _sender().hold()
 
 
 _lock = threading.Lock()

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from hrc.cobots import urua
@@ -131,11 +131,19 @@ class CobotDriver(abc.ABC):
     async def close(self) -> None: ...
 
     @abc.abstractmethod
-    async def run_step(self, command: StepCommand, *, timeout: float | None = None) -> StepResult:
+    async def run_step(
+        self,
+        command: StepCommand,
+        *,
+        timeout: float | None = None,
+        on_sent: Callable[[], None] | None = None,
+    ) -> StepResult:
         """Runs one step exactly once, or raises a DriverError.
 
         Calling it again with the same fence after a crash finishes the
         handshake of the step in flight instead of sending it again.
+        `on_sent` is called (on the driver's thread) as soon as the cobot has
+        accepted the step, long before it has run; not when nothing was sent.
         """
 
     @abc.abstractmethod

@@ -12,7 +12,7 @@ from __future__ import annotations
 import asyncio
 import os
 import threading
-from collections.abc import Coroutine, Mapping
+from collections.abc import Callable, Coroutine, Mapping
 from typing import Any, TypeVar
 
 from django.conf import settings
@@ -69,9 +69,15 @@ class SyncDriver:
     def name(self) -> str:
         return self.driver.name
 
-    def run_step(self, command: StepCommand, *, timeout: float | None = None) -> StepResult:
+    def run_step(
+        self,
+        command: StepCommand,
+        *,
+        timeout: float | None = None,
+        on_sent: Callable[[], None] | None = None,
+    ) -> StepResult:
         limit = timeout or self.driver.step_timeout
-        return _LOOP.run(self.driver.run_step(command, timeout=limit), limit)
+        return _LOOP.run(self.driver.run_step(command, timeout=limit, on_sent=on_sent), limit)
 
     def call(self, method: str, *arguments: Any, timeout: float | None = None) -> list[Any]:
         limit = timeout or self.driver.step_timeout

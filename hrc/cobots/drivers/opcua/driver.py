@@ -324,7 +324,13 @@ class OpcUaDriver(CobotDriver):
 
     # Steps -------------------------------------------------------------------
 
-    async def run_step(self, command: StepCommand, *, timeout: float | None = None) -> StepResult:
+    async def run_step(
+        self,
+        command: StepCommand,
+        *,
+        timeout: float | None = None,
+        on_sent: Callable[[], None] | None = None,
+    ) -> StepResult:
         started = time.monotonic()
         deadline = self._deadline(timeout or self.step_timeout)
         # Whether any pass sent the step: a session lost after sending leads to a
@@ -333,7 +339,7 @@ class OpcUaDriver(CobotDriver):
         async with self._step_lock:
             while True:
                 try:
-                    result = await self._drive(command, deadline, started, sent)
+                    result = await self._drive(command, deadline, started, sent, on_sent)
                     return dataclasses.replace(result, sent=result.sent or bool(sent))
                 except _SessionLost as lost:
                     logger.info(
@@ -347,7 +353,12 @@ class OpcUaDriver(CobotDriver):
                         ) from None
 
     async def _drive(
-        self, command: StepCommand, deadline: float, started: float, sent_before: list[bool]
+        self,
+        command: StepCommand,
+        deadline: float,
+        started: float,
+        sent_before: list[bool],
+        on_sent: Callable[[], None] | None,
     ) -> StepResult:
         await self._ensure_session(deadline)
         if self._cache_behind or not self._ready_and_idle():
@@ -371,6 +382,8 @@ class OpcUaDriver(CobotDriver):
             sent_before.append(True)  # before: a lost answer may hide a write that landed
             await self._send(command)
             sent = True
+            if on_sent is not None:
+                on_sent()
         await self._wait(
             lambda c: bool(c[OUT_BIT]) and (not fenced or self._token(OUT_FENCE) == token),
             deadline,

@@ -51,6 +51,29 @@ async def test_the_same_token_twice_runs_once(driver: OpcUaDriver, observer: Cli
     assert await executions(observer) == 1
 
 
+async def test_on_sent_comes_when_the_cobot_has_the_step_not_when_it_has_run(
+    driver: OpcUaDriver, observer: Client
+) -> None:
+    await driver.call("Simulator/InjectFault", "hang-next-step", "")
+    accepted = asyncio.Event()
+    step = asyncio.create_task(
+        driver.run_step(StepCommand(step=HOME, fence=Fence(15, 1)), on_sent=accepted.set)
+    )
+    await asyncio.wait_for(accepted.wait(), 10)
+    assert await read(observer, urua.register_path("Inputs", urua.FENCE_STEP)) == 15
+    assert not step.done()  # the step hangs: it has not run
+    await driver.call("Simulator/ClearFault")
+    assert (await asyncio.wait_for(step, 10)).outcome == "ran"
+
+
+async def test_on_sent_is_not_called_when_nothing_is_sent(driver: OpcUaDriver) -> None:
+    command = StepCommand(step=PICK, fence=Fence(16, 1))
+    await driver.run_step(command)
+    calls: list[None] = []
+    again = await driver.run_step(command, on_sent=lambda: calls.append(None))
+    assert (again.sent, calls) == (False, [])
+
+
 async def test_an_older_token_is_refused_by_the_program_without_moving(
     driver: OpcUaDriver, observer: Client
 ) -> None:
