@@ -91,7 +91,6 @@ def run_next_job(job_id: int) -> None:
         try:
             result = _execute(lease, on_sent=hold.release)
         except DriverError as error:
-            hold.release()
             fail_job(lease, error)
         else:
             finish_job(lease, result)
