@@ -26,7 +26,7 @@ from hrc.live import broadcast
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
 from tests import factories
-from tests.cases.patterns import PICK, PROGRAM
+from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.live.server import LiveServer, MonitorProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -315,3 +315,50 @@ def test_the_tablet_fits_a_ten_inch_tablet_both_ways(
     screenshot(page, "tablet-portrait")
     assert page.evaluate("document.documentElement.scrollWidth") <= PORTRAIT["width"]
     assert re.search(r"Cell A", page.locator("header.site").inner_text())
+
+
+def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_elsewhere(
+    server: LiveServer,
+    tablet: BrowserContext,
+    operator: User,
+    organisation: Organisation,
+    engineer: User,
+    screenshot: Screenshot,
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer, draft=shared_space())
+    weld = factories.make_cobot(organisation, name="weld-arm", cell="weld")
+    paint = factories.make_cobot(organisation, name="paint-arm", cell="paint")
+
+    def start(cobot: Any) -> WorkItem:
+        mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
+        case = case_services.start_case(version, started_by=None, actor_mapping=mapping)
+        return factories.open_work_item(case, "to1")
+
+    at_weld, at_paint = start(weld), start(paint)
+    page = tablet.new_page()
+    _sign_in(page, server.url, operator)
+    page.goto(f"{server.url}/tablet/weld/")
+    expect(page.locator(".connection")).to_have_text("Live")
+    cards = page.locator(".cards.mine .card")
+    expect(cards).to_have_count(1)
+    expect(cards).to_have_attribute("data-item", str(at_weld.pk))
+    expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at other cells.")
+    screenshot(page, "tablet-cell-scoped")
+
+    # Live, no reload: a new case at the paint cell only adds to the count; the operator's
+    # paint task, once started from the floor, is theirs here too.
+    start(paint)
+    broadcast.flush()
+    expect(page.locator(".elsewhere")).to_have_text("2 more tasks wait for you at other cells.")
+    expect(cards).to_have_count(1)
+    case_services.start_work_item(at_paint, user=operator)
+    broadcast.flush()
+    expect(cards).to_have_count(2)
+    expect(page.locator(f'.card[data-item="{at_paint.pk}"]')).to_have_attribute(
+        "data-state", "running"
+    )
+    expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at other cells.")
+
+    page.goto(f"{server.url}/tablet/")  # the whole floor: every task, nothing elsewhere
+    expect(page.locator(".cards.mine .card")).to_have_count(3)
+    expect(page.locator(".elsewhere")).to_have_count(0)

@@ -6,7 +6,7 @@ import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
 import { ApiError, request } from "./api";
 import { type FormSchema, renderForm } from "./form";
-import { activity, cobotsOf, degrees, humanSafety, myTasks, nextAction, teamTasks } from "./view";
+import { activity, cobotsOf, degrees, elsewhere, humanSafety, myTasks, nextAction, teamTasks } from "./view";
 
 interface Config {
   organisation: number;
@@ -56,9 +56,18 @@ function render(): void {
   if (!state) return;
   renderCards($(".cards.mine"), myTasks(state), state, "Nothing for you right now.");
   renderCards($(".cards.team"), teamTasks(state), state, "No open team tasks.");
+  renderElsewhere(state);
   renderCobots(state);
   renderStop(state);
   renderMessages();
+}
+
+function renderElsewhere(state: LiveState): void {
+  const note = root.querySelector<HTMLElement>(".elsewhere");
+  if (!note) return; // the whole floor's tablet shows every task
+  const count = elsewhere(state);
+  note.hidden = count === 0;
+  note.textContent = `${count} more ${count === 1 ? "task waits" : "tasks wait"} for you at other cells.`;
 }
 
 function renderCards(container: HTMLElement, items: WorkItemData[], state: LiveState, empty: string): void {

@@ -3,33 +3,54 @@
 import type { CobotData, WorkItemData } from "../live/events";
 import type { LiveState } from "../live/store";
 
-/** Operator tasks that are the user's: claimed or started by them, or offered to them by name. */
+/** Operator tasks that are the user's: claimed or started by them, wherever their case runs, and
+ * those offered to them by name at this tablet's cell (see `atThisCell`). */
 export function myTasks(state: LiveState): WorkItemData[] {
-  const me = state.user.id;
   return sorted(
     [...state.workItems.values()].filter(
-      (item) =>
-        item.kind === "operator" &&
-        (item.claimed_by === me ||
-          (item.claimed_by === null && item.state === "offered" && item.candidates.includes(me))),
+      (item) => isMine(state, item) && (item.claimed_by === state.user.id || atThisCell(state, item)),
     ),
   );
 }
 
-/** Open operator tasks of the user's teams that nobody has taken: theirs to claim. */
+/** Open operator tasks of the user's teams that nobody has taken, at this tablet's cell: theirs to claim. */
 export function teamTasks(state: LiveState): WorkItemData[] {
+  return sorted([...state.workItems.values()].filter((item) => isTeams(state, item) && atThisCell(state, item)));
+}
+
+/** How many tasks the user could take that a cell's tablet leaves out: they wait at other cells. */
+export function elsewhere(state: LiveState): number {
+  return [...state.workItems.values()].filter(
+    (item) => item.claimed_by === null && (isMine(state, item) || isTeams(state, item)) && !atThisCell(state, item),
+  ).length;
+}
+
+/** Whether the item's case works at this tablet's cell. A tablet of the whole floor (no cell)
+ * shows every case. A cell's tablet knows that cell's cobots only (the server sends no others):
+ * it shows the cases that use one of them, and those that use no cobot, which belong to no cell.
+ * A task the user already holds is theirs to finish wherever it is, so callers keep it anyway. */
+export function atThisCell(state: LiveState, item: WorkItemData): boolean {
+  if (!state.cell) return true;
+  const cobots = state.cases.get(item.case)?.cobots ?? [];
+  return cobots.length === 0 || cobots.some((id) => state.cobots.has(id));
+}
+
+function isMine(state: LiveState, item: WorkItemData): boolean {
   const me = state.user.id;
-  const teams = new Set(state.user.teams);
-  return sorted(
-    [...state.workItems.values()].filter(
-      (item) =>
-        item.kind === "operator" &&
-        item.state === "offered" &&
-        item.claimed_by === null &&
-        item.team !== null &&
-        teams.has(item.team) &&
-        !item.candidates.includes(me),
-    ),
+  return (
+    item.kind === "operator" &&
+    (item.claimed_by === me || (item.claimed_by === null && item.state === "offered" && item.candidates.includes(me)))
+  );
+}
+
+function isTeams(state: LiveState, item: WorkItemData): boolean {
+  return (
+    item.kind === "operator" &&
+    item.state === "offered" &&
+    item.claimed_by === null &&
+    item.team !== null &&
+    state.user.teams.includes(item.team) &&
+    !item.candidates.includes(state.user.id)
   );
 }
 

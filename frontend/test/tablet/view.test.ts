@@ -1,0 +1,78 @@
+import { describe, expect, it } from "vitest";
+import type { Snapshot } from "../../src/live/events";
+import { type LiveState, LiveStore } from "../../src/live/store";
+import { atThisCell, elsewhere, myTasks, teamTasks } from "../../src/tablet/view";
+import { item, snapshot } from "../live/fixtures";
+
+const WELD_ARM = {
+  id: 5,
+  name: "weld-arm",
+  cell: "weld",
+  stopped: false,
+  state: null,
+  queue: { cobot: 5, at: 1, queue_length: 0, current: null, waiting_for: "" },
+};
+
+/** Three cases: 10 uses the weld cell's cobot, 11 a cobot of another cell (not sent to a weld
+ * tablet), 12 no cobot at all. Each has one task offered to the user by name (101, 111, 121). */
+function floor(cell: string, overrides: Partial<Snapshot> = {}): LiveState {
+  const store = new LiveStore();
+  store.apply(
+    snapshot({
+      cell,
+      cases: [
+        { id: 10, seq: 2, status: "running", name: "Weld", cobots: [5] },
+        { id: 11, seq: 2, status: "running", name: "Paint", cobots: [6] },
+        { id: 12, seq: 2, status: "running", name: "Count", cobots: [] },
+      ],
+      work_items: [item({ id: 101, case: 10 }), item({ id: 111, case: 11 }), item({ id: 121, case: 12 })],
+      cobots: cell ? [WELD_ARM] : [WELD_ARM, { ...WELD_ARM, id: 6, name: "paint-arm", cell: "paint" }],
+      ...overrides,
+    }),
+  );
+  return store.state!;
+}
+
+const ids = (items: Array<{ id: number }>): number[] => items.map((i) => i.id);
+
+describe("a cell's tablet", () => {
+  it("offers the tasks of its cell's cases and of cases with no cobot, not those of other cells", () => {
+    const state = floor("weld");
+    expect(ids(myTasks(state))).toEqual([101, 121]);
+    expect(atThisCell(state, state.workItems.get(111)!)).toBe(false);
+    expect(elsewhere(state)).toBe(1);
+  });
+
+  it("keeps a task the user holds in another cell: theirs to finish", () => {
+    const state = floor("weld", {
+      work_items: [item({ id: 111, case: 11, state: "running", claimed_by: 7, candidates: [7] })],
+    });
+    expect(ids(myTasks(state))).toEqual([111]);
+    expect(elsewhere(state)).toBe(0);
+  });
+
+  it("scopes team tasks the same way, and counts them among those waiting elsewhere", () => {
+    const team = { candidates: [], team: 3 };
+    const state = floor("weld", {
+      work_items: [item({ id: 101, case: 10, ...team }), item({ id: 111, case: 11, ...team })],
+    });
+    expect(ids(teamTasks(state))).toEqual([101]);
+    expect(ids(myTasks(state))).toEqual([]);
+    expect(elsewhere(state)).toBe(1);
+  });
+
+  it("does not count what someone else took or what is not offered to the user", () => {
+    const state = floor("weld", {
+      work_items: [item({ id: 111, case: 11, state: "claimed", claimed_by: 8 }), item({ id: 112, case: 11, candidates: [8] })],
+    });
+    expect(elsewhere(state)).toBe(0);
+  });
+});
+
+describe("the whole floor's tablet", () => {
+  it("offers every case's tasks and has nothing elsewhere", () => {
+    const state = floor("");
+    expect(ids(myTasks(state))).toEqual([101, 111, 121]);
+    expect(elsewhere(state)).toBe(0);
+  });
+});
