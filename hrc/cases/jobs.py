@@ -26,7 +26,7 @@ from typing import Any
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import Exists, OuterRef, Q
+from django.db.models import Exists, Q, QuerySet
 from django.utils import timezone
 
 from hrc.cases import dispatch, services
@@ -117,23 +117,29 @@ def _lease_next(which: Q) -> Lease | None:
         # NO KEY: a case service inserting a job or an interruption takes a key-share lock
         # on the cobot row (the foreign key) while it holds its case; FOR UPDATE would
         # wait for it while we wait for the case, a deadlock.
-        locked = Cobot.objects.select_for_update(of=("self",), no_key=True).filter(which)
-        cobot_id = locked.values_list("pk", flat=True).first()
-        if cobot_id is None:
-            return None
-        busy = Job.objects.filter(cobot=OuterRef("pk"), state=JobState.RUNNING)
-        cobot = Cobot.objects.annotate(
-            busy=Exists(busy), paused=Exists(_unsettled_interruptions(OuterRef("pk")))
-        ).get(pk=cobot_id)
-        if cobot.busy or cobot.paused:
+        # A locked row is read as it is now, whatever the statement's snapshot: its own
+        # columns (stopped_at) may come with the lock.
+        cobot = Cobot.objects.select_for_update(of=("self",), no_key=True).filter(which).first()
+        if cobot is None:
             return None
         if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.live.services)
             return None
-        queued = Job.objects.filter(
-            cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
-            case__status=CaseStatus.RUNNING,
-        ).values_list("pk", "case_id")[: settings.HRC_QUEUE_LOOKAHEAD]  # fmt: skip
-        for job_id, case_id in list(queued):
+        # The queue, with the reasons the whole cobot waits (a job running, a pause for an
+        # operator in a shared area) on each row: a second statement, so they are fresh.
+        queued = (
+            Job.objects.filter(
+                cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
+                case__status=CaseStatus.RUNNING,
+            )
+            .annotate(
+                busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
+                paused=Exists(_unsettled_interruptions(cobot)),
+            )
+            .values_list("pk", "case_id", "busy", "paused")[: settings.HRC_QUEUE_LOOKAHEAD]
+        )  # fmt: skip
+        for job_id, case_id, busy, paused in list(queued):
+            if busy or paused:
+                return None
             lease = _lease_if_ready(cobot, job_id, case_id, now)
             if lease is not None:
                 return lease
@@ -194,7 +200,7 @@ def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     return ""
 
 
-def _unsettled_interruptions(cobot: Cobot | OuterRef) -> Any:
+def _unsettled_interruptions(cobot: Cobot) -> QuerySet[Interruption]:
     return Interruption.objects.filter(cobot=cobot).filter(
         Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
