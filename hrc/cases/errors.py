@@ -17,6 +17,12 @@ class NotAllowed(CaseError):
     status = 403
 
 
+class NotFound(CaseError):
+    """Not there, or not in the user's organisations (404): an outsider learns nothing."""
+
+    status = 404
+
+
 class Conflict(CaseError):
     """The case or work item has moved on (409): completed by someone else, ended, withdrawn."""
 

@@ -19,7 +19,7 @@ from typing import Any
 import jsonschema
 from django.contrib.auth.models import User
 from django.db import transaction
-from django.db.models import Exists, OuterRef, Q
+from django.db.models import Exists, OuterRef, Q, Subquery
 from django.utils import timezone
 
 from hrc.cases import dispatch
@@ -34,7 +34,7 @@ from hrc.cases.choices import (
     WorkItemKind,
     WorkItemState,
 )
-from hrc.cases.errors import Conflict, Invalid, NotAllowed
+from hrc.cases.errors import Conflict, Invalid, NotAllowed, NotFound
 from hrc.cases.mapping import resolve_actor_mapping
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
@@ -141,9 +141,12 @@ def resume_case(case: Case, *, by: User | None) -> Case:
 
 
 # Operator work items ---------------------------------------------------------------
+#
+# Each takes the work item or its id (the API's, unread) and reads it again under its
+# case's lock; NotFound when it is not one of the user's organisations'.
 
 
-def claim_work_item(item: WorkItem, *, user: User) -> WorkItem:
+def claim_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
     """Takes an offered operator task for `user`; Conflict when someone else has it."""
     with transaction.atomic():
         case, item = _locked_item(item, user)
@@ -156,7 +159,7 @@ def claim_work_item(item: WorkItem, *, user: User) -> WorkItem:
     return item
 
 
-def unclaim_work_item(item: WorkItem, *, user: User) -> WorkItem:
+def unclaim_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
     """Gives a claimed, not yet started task back to its candidates."""
     with transaction.atomic():
         case, item = _locked_item(item, user)
@@ -169,7 +172,7 @@ def unclaim_work_item(item: WorkItem, *, user: User) -> WorkItem:
     return item
 
 
-def start_work_item(item: WorkItem, *, user: User) -> WorkItem:
+def start_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
     """Starts an operator task (claiming it if nobody has); the other tasks of a choice withdraw."""
     with transaction.atomic():
         case, item = _locked_item(item, user)
@@ -192,7 +195,7 @@ def start_work_item(item: WorkItem, *, user: User) -> WorkItem:
 
 
 def complete_work_item(
-    item: WorkItem, *, user: User, data: Mapping[str, Any] | None = None
+    item: WorkItem | int, *, user: User, data: Mapping[str, Any] | None = None
 ) -> WorkItem:
     """Completes a running operator task with its form data (checked against the task's form).
 
@@ -657,16 +660,31 @@ def lock_case(case_id: int) -> Case:
     )
 
 
-def _locked_item(item: WorkItem, user: User) -> tuple[Case, WorkItem]:
+def _locked_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
     """The case (locked) and a fresh copy of an operator work item the user may perform,
-    the case and the user it is claimed by attached."""
+    the case and the user it is claimed by attached.
+
+    The case is found through the item and the user's memberships in the statement
+    that locks it: the organisations' wall costs the API's request no read of its own.
+    """
     from hrc.cases.selectors import performable_by
 
-    case = lock_case(item.case_id)
+    item_id = item.pk if isinstance(item, WorkItem) else item
+    case = (
+        Case.objects.select_for_update(of=("self",), no_key=True)
+        .select_related("version")
+        .filter(
+            pk=Subquery(WorkItem.objects.filter(pk=item_id).values("case_id")),
+            organisation__memberships__user_id=user.pk,
+        )
+        .first()
+    )
+    if case is None:
+        raise NotFound(f"There is no work item {item_id} in your organisations.")
     offered = WorkItem.objects.filter(
         performable_by(user), pk=OuterRef("pk"), case__organisation__memberships__user_id=user.pk
     )  # a candidate (or in the item's team) and still a member; read with the item in one query
-    item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item.pk)
+    item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item_id)
     if item.kind != WorkItemKind.OPERATOR:
         raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
     if not item.performable:

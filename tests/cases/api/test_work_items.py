@@ -238,6 +238,20 @@ def test_a_task_not_offered_to_me_is_a_403(
         assert response.data["detail"] == "count parts is not offered to you."
 
 
+@pytest.mark.parametrize("action", ["claim", "unclaim", "start", "complete"])
+@pytest.mark.parametrize("item_id", ["999999", "count", "-1"])
+def test_an_action_on_a_work_item_that_is_not_there_is_a_404_naming_it(
+    operator_client: APIClient, choice_case: Case, action: str, item_id: str
+) -> None:
+    before = list(WorkItem.objects.values_list("pk", "state"))
+    response = operator_client.post(
+        f"/api/work-items/{item_id}/{action}/", {"data": {}}, format="json"
+    )
+    assert response.status_code == 404
+    assert response.data == {"detail": f"There is no work item {item_id} in your organisations."}
+    assert list(WorkItem.objects.values_list("pk", "state")) == before
+
+
 def test_conflicts_are_409s_that_say_why(
     operator_client: APIClient, choice_case: Case, colleague: User, engineer: User
 ) -> None:
