@@ -671,3 +671,37 @@ def test_keys_select_copy_paste_delete_and_undo(
     expect(page.locator(".djs-element.selected")).to_have_count(
         page.locator(".djs-shape, .djs-connection").count() - 2  # not the two lanes
     )
+
+
+def test_a_lane_moves_up_with_its_tasks_and_one_undo_puts_it_back(
+    page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
+) -> None:
+    pattern = _assembly(organisation)  # lanes c (the cobot's) above o
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    panel = page.get_by_role("region", name="Properties")
+    cobot, operator, operator_task = _box(page, "c"), _box(page, "o"), _box(page, "to1")
+    assert cobot["y"] < operator["y"]
+
+    page.mouse.click(operator["x"] + 10, operator["y"] + operator["height"] / 2)
+    expect(panel.get_by_role("button", name="Move lane down")).to_be_disabled()
+    panel.get_by_role("button", name="Move lane up").click()
+    _until(lambda: abs(_box(page, "o")["y"] - cobot["y"]) < 2)
+    assert abs(_box(page, "c")["y"] - operator["y"]) < 2  # both lanes are as tall
+    # The operator's task went up with its lane, and is still the operator's.
+    assert abs(_box(page, "to1")["y"] - (operator_task["y"] - (operator["y"] - cobot["y"]))) < 2
+    expect(panel.get_by_role("button", name="Move lane up")).to_be_disabled()
+    page.get_by_role("button", name="Save", exact=True).click()
+    expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text("Saved.", timeout=CHECKED)
+    pattern.refresh_from_db()
+    lanes = {lane["actor"]: lane["y"] for lane in pattern.draft["layout"]["lanes"]}
+    assert lanes["o"] < lanes["c"]
+    performers = {t["id"]: t.get("performer") for t in pattern.draft["processes"][0]["transitions"]}
+    assert performers == {
+        "t1": None, "t2": None, "tc1": "c", "tc2": "c", "tc3": "c", "to1": "o", "to2": "o"
+    }  # fmt: skip
+
+    page.keyboard.press("Control+z")  # the whole swap, lanes and tasks
+    _until(lambda: _near(_box(page, "o"), operator))
+    assert _near(_box(page, "c"), cobot)
+    assert _near(_box(page, "to1"), operator_task)

@@ -16,6 +16,7 @@ import type { Shape } from "diagram-js/lib/model/Types";
 import { nextId } from "../../model/ids";
 import { centre, isLane, isNode, laneAt, laneObject, nodeObject, objectOf, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
+import { SWAPPING_LANES } from "../modeling/MoveLaneHandler";
 import type PatternModeling from "../modeling/PatternModeling";
 
 const RIGHT_MARGIN = 160;
@@ -33,7 +34,14 @@ export default class LaneBehavior extends CommandInterceptor {
     super(eventBus);
     // `true`: the handlers get the command's context, not the event around it.
     this.preExecute("shape.create", (context: CommandContext) => this.placeNew(context.shape, context.position), true);
-    this.postExecute("elements.move", (context: CommandContext) => this.follow(context.shapes as Shape[]), true);
+    this.postExecute(
+      "elements.move",
+      (context: CommandContext) => {
+        // Halfway through a swap a lane's tasks pass over the other lane: they stay its actor's.
+        if (!context.hints?.[SWAPPING_LANES]) this.follow(context.shapes as Shape[]);
+      },
+      true,
+    );
     this.postExecute(["shape.create", "elements.move", "elements.create"], () => this.fitWidth(), true);
     this.preExecute(
       "shape.resize",

@@ -12,6 +12,7 @@ import type { Shape } from "diagram-js/lib/model/Types";
 import type { ActorType, Extra } from "../../model/document";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import AddLaneHandler, { type AddLaneContext } from "./AddLaneHandler";
+import MoveLaneHandler, { type MoveLaneContext } from "./MoveLaneHandler";
 import UpdateDataHandler from "./UpdateDataHandler";
 import UpdateIdHandler from "./UpdateIdHandler";
 
@@ -33,6 +34,7 @@ export default class PatternModeling extends Modeling {
       "element.updateData": UpdateDataHandler,
       "element.updateId": UpdateIdHandler,
       "lane.add": AddLaneHandler,
+      "lane.move": MoveLaneHandler,
     };
   }
 
@@ -47,6 +49,12 @@ export default class PatternModeling extends Modeling {
 
   updateId(element: ElementLike, id: string): void {
     this.commands.execute("element.updateId", { element, id });
+  }
+
+  /** Swaps the lane with the one above (-1) or below (1) it; nothing at either end. */
+  moveLane(lane: Shape, by: -1 | 1): void {
+    const context: MoveLaneContext = { lane, by };
+    this.commands.execute("lane.move", context);
   }
 
   addLane(type: ActorType, id?: string): Shape {

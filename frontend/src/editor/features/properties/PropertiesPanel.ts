@@ -16,7 +16,7 @@ import { CONSTRAINT_TYPES } from "../../model/document";
 import { isLane, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
-import { add, field, heading, note, select } from "./fields";
+import { add, button, field, heading, note, select } from "./fields";
 import { taskSection } from "./TaskSection";
 
 type Element = Shape | Connection;
@@ -116,6 +116,10 @@ export default class PropertiesPanel {
     }
     const root = objectOf(this.canvas.getRootElement() as Shape) as RootObject;
     select(this.panel, "Net (process)", object.process ?? "", root.processes.map((p): [string, string] => [String(p.id), String(p.id)]), (process) => this.modeling.updateData(shape, {}, { process }));
+    const lanes = (this.elementRegistry.filter(isLane) as Shape[]).sort((a, b) => a.y - b.y);
+    const index = lanes.indexOf(shape);
+    button(this.panel, "Move lane up", () => this.modeling.moveLane(shape, -1)).disabled = index <= 0;
+    button(this.panel, "Move lane down", () => this.modeling.moveLane(shape, 1)).disabled = index === lanes.length - 1;
   }
 
   private constraintSection(connection: Connection, object: ConstraintObject): void {
