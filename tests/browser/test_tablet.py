@@ -354,9 +354,10 @@ def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_elsewhere
     case_services.start_work_item(at_paint, user=operator)
     broadcast.flush()
     expect(cards).to_have_count(2)
-    expect(page.locator(f'.card[data-item="{at_paint.pk}"]')).to_have_attribute(
-        "data-state", "running"
-    )
+    away = page.locator(f'.card[data-item="{at_paint.pk}"]')
+    expect(away).to_have_attribute("data-state", "running")
+    expect(away.locator(".away")).to_have_text("At another cell: go there to do it.")
+    expect(page.locator(f'.card[data-item="{at_weld.pk}"] .away')).to_have_count(0)
     expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at other cells.")
 
     page.goto(f"{server.url}/tablet/")  # the whole floor: every task, nothing elsewhere

@@ -6,7 +6,7 @@ import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
 import { ApiError, request } from "./api";
 import { type FormSchema, renderForm } from "./form";
-import { activity, cobotsOf, degrees, elsewhere, humanSafety, myTasks, nextAction, teamTasks } from "./view";
+import { activity, atThisCell, cobotsOf, degrees, elsewhere, humanSafety, myTasks, nextAction, teamTasks } from "./view";
 
 interface Config {
   organisation: number;
@@ -87,6 +87,8 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     element("h3", "", item.label || item.task),
     element("p", "meta", `${caseName ? `${caseName} · ` : ""}case ${item.case} · ${item.state}`),
   );
+  // Only a task the operator holds shows up here from another cell: say so, or they wait in vain.
+  if (!atThisCell(state, item)) article.append(element("p", "away", "At another cell: go there to do it."));
   if (item.instructions) article.append(element("p", "instructions", item.instructions));
   const cobots = cobotsOf(state, item);
   if (cobots.length) {
