@@ -1,0 +1,65 @@
+"""What the tablets read: a cobot's queue, as its panel shows it."""
+
+from __future__ import annotations
+
+import pytest
+from django.contrib.auth.models import User
+
+from hrc.cases import jobs
+from hrc.cases import services as case_services
+from hrc.cases.models import Case, Job
+from hrc.cobots.models import Cobot
+from hrc.live.selectors import cobot_queues
+from hrc.organisations.models import Organisation
+from hrc.patterns.models import PatternVersion
+from tests import factories
+
+pytestmark = pytest.mark.django_db
+
+
+def _hand_over(version: PatternVersion, operator: User, cobot: Cobot) -> Case:
+    """A hand-over case whose operator task is done: its cobot task waits in the cobot's queue."""
+    case = factories.make_case(
+        version, started_by=operator,
+        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+    )  # fmt: skip
+    item = factories.open_work_item(case, "to1")
+    case_services.start_work_item(item, user=operator)
+    case_services.complete_work_item(item, user=operator)
+    return case
+
+
+def test_a_cobots_queue_counts_its_jobs_names_the_running_step_and_the_first_reason_to_wait(
+    organisation: Organisation, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer)
+    idle = factories.make_cobot(organisation, cell="paint")
+    cases = [_hand_over(version, operator, cobot) for _ in range(4)]
+    lease = jobs.lease_next_job(cobot.pk)  # the first case's step runs
+    assert lease is not None
+    assert lease.case_id == cases[0].pk
+    # The third case's step waits (say, for an operator in a shared area), then the fourth's.
+    queued = Job.objects.filter(case__in=cases[2:]).order_by("queued_at", "id")
+    Job.objects.filter(pk=queued[1].pk).update(waiting_for="the fourth's reason")
+    Job.objects.filter(pk=queued[0].pk).update(waiting_for="the third's reason")
+
+    rows = cobot_queues([idle.pk, cobot.pk])
+
+    assert [(org, cell) for org, cell, _ in rows] == [
+        (organisation.pk, "paint"),
+        (organisation.pk, cobot.cell),
+    ]  # in the order asked
+    assert {key: rows[0][2][key] for key in ("cobot", "queue_length", "current", "waiting_for")} == {
+        "cobot": idle.pk, "queue_length": 0, "current": None, "waiting_for": "",
+    }  # fmt: skip
+    queue = rows[1][2]
+    assert (queue["cobot"], queue["queue_length"], queue["waiting_for"]) == (
+        cobot.pk, 4, "the third's reason",
+    )  # fmt: skip
+    running = Job.objects.get(pk=lease.job_id)
+    assert isinstance(running.command["number"], int)  # the program step the cobot runs
+    assert queue["current"] == {
+        "case": cases[0].pk, "work_item": running.work_item_id,
+        "task": "tc1", "label": "place insert", "kind": "step",
+        "step": running.command["number"], "attempt": 1,
+    }  # fmt: skip
