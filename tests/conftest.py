@@ -12,7 +12,6 @@ from django.contrib.auth.models import User
 from django.test import Client
 from rest_framework.test import APIClient
 
-from hrc.cases import services
 from hrc.cases.models import Case
 from hrc.cobots.models import Cobot
 from hrc.organisations import services as organisation_services
@@ -136,12 +135,4 @@ def cobot(organisation: Organisation) -> Cobot:
 def step_case(organisation: Organisation, engineer: User, operator: User, cobot: Cobot) -> Case:
     """A hand-over case: the operator has prepared the workpiece, the cobot step is queued."""
     version = factories.make_version(organisation, published_by=engineer)
-    case = factories.make_case(
-        version,
-        started_by=engineer,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
-    )
-    item = factories.open_work_item(case, "to1")
-    services.start_work_item(item, user=operator)
-    services.complete_work_item(item, user=operator)
-    return case
+    return factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)

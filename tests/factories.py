@@ -206,6 +206,21 @@ def make_case(
     )
 
 
+def hand_over_case(
+    version: PatternVersion, *, started_by: User, operator: User, cobot: Cobot
+) -> Case:
+    """A case of the hand-over pattern (valid_document()) whose operator has prepared the
+    workpiece (to1 done): its cobot step waits in the cobot's queue."""
+    case = make_case(
+        version, started_by=started_by,
+        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+    )  # fmt: skip
+    item = open_work_item(case, "to1")
+    case_services.start_work_item(item, user=operator)
+    case_services.complete_work_item(item, user=operator)
+    return case
+
+
 def open_work_item(case: Case, task: str) -> WorkItem:
     """The case's open work item for the task; fails when there is none."""
     return WorkItem.objects.get(case=case, task=task, state__in=sorted(OPEN_WORK_ITEM_STATES))

@@ -6,27 +6,13 @@ import pytest
 from django.contrib.auth.models import User
 
 from hrc.cases import jobs
-from hrc.cases import services as case_services
-from hrc.cases.models import Case, Job
+from hrc.cases.models import Job
 from hrc.cobots.models import Cobot
 from hrc.live.selectors import cobot_queues
 from hrc.organisations.models import Organisation
-from hrc.patterns.models import PatternVersion
 from tests import factories
 
 pytestmark = pytest.mark.django_db
-
-
-def _hand_over(version: PatternVersion, operator: User, cobot: Cobot) -> Case:
-    """A hand-over case whose operator task is done: its cobot task waits in the cobot's queue."""
-    case = factories.make_case(
-        version, started_by=operator,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
-    )  # fmt: skip
-    item = factories.open_work_item(case, "to1")
-    case_services.start_work_item(item, user=operator)
-    case_services.complete_work_item(item, user=operator)
-    return case
 
 
 def test_a_cobots_queue_counts_its_jobs_names_the_running_step_and_the_first_reason_to_wait(
@@ -34,7 +20,10 @@ def test_a_cobots_queue_counts_its_jobs_names_the_running_step_and_the_first_rea
 ) -> None:
     version = factories.make_version(organisation, published_by=engineer)
     idle = factories.make_cobot(organisation, cell="paint")
-    cases = [_hand_over(version, operator, cobot) for _ in range(4)]
+    cases = [
+        factories.hand_over_case(version, started_by=operator, operator=operator, cobot=cobot)
+        for _ in range(4)
+    ]
     lease = jobs.lease_next_job(cobot.pk)  # the first case's step runs
     assert lease is not None
     assert lease.case_id == cases[0].pk
