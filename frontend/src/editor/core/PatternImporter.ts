@@ -14,9 +14,9 @@ import type { PatternDocument } from "../model/document";
 import { type Snapshot, toDocument, toSnapshot } from "../model/snapshot";
 import {
   type ConstraintObject,
-  isLane,
   isNode,
   laneObject,
+  lanesTopDown,
   nodeObject,
   objectOf,
   type PatternObject,
@@ -112,7 +112,7 @@ export default class PatternImporter {
   snapshot(): Snapshot {
     const root = objectOf(this.canvas.getRootElement()) as RootObject;
     const elements = this.elementRegistry.getAll();
-    const lanes = (elements.filter(isLane) as Shape[]).sort((a, b) => a.y - b.y);
+    const lanes = lanesTopDown(elements);
     const nodes = elements.filter(isNode) as Shape[];
     const connections = elements.filter((element) => "waypoints" in element) as Connection[];
     const width = Math.max(root.width, ...lanes.map((lane) => lane.width));

@@ -115,6 +115,11 @@ export function performerOf(element: Element): string | undefined {
 }
 
 /** The lane whose band holds the height y; null outside every lane. */
+/** The lanes among the elements, top to bottom. */
+export function lanesTopDown(elements: Element[]): Shape[] {
+  return (elements.filter(isLane) as Shape[]).sort((a, b) => a.y - b.y);
+}
+
 export function laneAt(lanes: Shape[], y: number): Shape | null {
   return lanes.find((lane) => y >= lane.y && y < lane.y + lane.height) ?? null;
 }

@@ -14,7 +14,7 @@ import type { CommandContext } from "diagram-js/lib/command/CommandStack";
 import type { Shape } from "diagram-js/lib/model/Types";
 
 import { nextId } from "../../model/ids";
-import { centre, isLane, isNode, laneAt, laneObject, nodeObject, objectOf, type RootObject } from "../../core/elements";
+import { centre, isLane, isNode, laneAt, lanesTopDown, laneObject, nodeObject, objectOf, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import { SWAPPING_LANES } from "../modeling/MoveLaneHandler";
 import type PatternModeling from "../modeling/PatternModeling";
@@ -70,7 +70,7 @@ export default class LaneBehavior extends CommandInterceptor {
   }
 
   lanes(): Shape[] {
-    return (this.elementRegistry.filter(isLane) as Shape[]).sort((a, b) => a.y - b.y);
+    return lanesTopDown(this.elementRegistry.getAll());
   }
 
   /** The process a node in this lane belongs to: the lane actor's, else the first. */

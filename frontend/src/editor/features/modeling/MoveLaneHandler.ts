@@ -8,7 +8,7 @@ import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
 import type { CommandContext } from "diagram-js/lib/command/CommandStack";
 import type { Shape } from "diagram-js/lib/model/Types";
 
-import { centre, isLane, isNode, laneAt } from "../../core/elements";
+import { centre, isNode, laneAt, lanesTopDown } from "../../core/elements";
 import type PatternModeling from "./PatternModeling";
 
 export interface MoveLaneContext extends CommandContext {
@@ -28,7 +28,7 @@ export default class MoveLaneHandler {
   ) {}
 
   preExecute(context: MoveLaneContext): void {
-    const lanes = (this.elementRegistry.filter(isLane) as Shape[]).sort((a, b) => a.y - b.y);
+    const lanes = lanesTopDown(this.elementRegistry.getAll());
     const index = lanes.indexOf(context.lane);
     const other = lanes[index + context.by];
     if (index < 0 || !other) return; // the first lane goes no higher, the last no lower

@@ -13,7 +13,7 @@ import { PATTERN_NAMES } from "../../model/document";
 import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
-import { isLane, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
+import { isLane, lanesTopDown, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
 import { add, button, field, heading, note, select } from "./fields";
@@ -116,7 +116,7 @@ export default class PropertiesPanel {
     }
     const root = objectOf(this.canvas.getRootElement() as Shape) as RootObject;
     select(this.panel, "Net (process)", object.process ?? "", root.processes.map((p): [string, string] => [String(p.id), String(p.id)]), (process) => this.modeling.updateData(shape, {}, { process }));
-    const lanes = (this.elementRegistry.filter(isLane) as Shape[]).sort((a, b) => a.y - b.y);
+    const lanes = lanesTopDown(this.elementRegistry.getAll());
     const index = lanes.indexOf(shape);
     button(this.panel, "Move lane up", () => this.modeling.moveLane(shape, -1)).disabled = index <= 0;
     button(this.panel, "Move lane down", () => this.modeling.moveLane(shape, 1)).disabled = index === lanes.length - 1;
