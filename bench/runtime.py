@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING, Any, Self
 
 from bench.report import load_average, print_load, write_results
 from bench.runtime_rig import (
+    FLOOR_QUEUE,
     FLOOR_REGISTER,
     FLOOR_VALUES_FROM,
     LOOP_SHAPE,
@@ -77,6 +78,7 @@ def measure_signalling(bench: Rig, settings: Settings, progress: Callable[[str],
     bench.use_workers(1)
     floors = {"celery_dispatch": _celery_floor(bench, settings)}
     floors["db_commit"] = _commit_floor(bench.database_url, settings)
+    floors["orm_transaction"], _ = _orm_floor(bench, settings.warmup, settings.floor_samples)
     floors["api_request"] = _api_floor(bench, settings)
     gateway, cobot = bench.gateways[0], bench.cobots[0]
     observer = Observer(gateway.endpoint, cobot.name, [urua.FENCE_STEP, FLOOR_REGISTER]).start()
@@ -127,7 +129,6 @@ def _celery_floor(bench: Rig, settings: Settings) -> list[float]:
     import redis
 
     client = redis.Redis.from_url(bench.redis.url)
-    floor_app.conf.broker_url = bench.redis.url
     key, times = f"bench-floor-{uuid.uuid4().hex}", []
     worker = FloorWorker(bench.workdir, bench.redis.url).start()
     try:
@@ -175,6 +176,40 @@ def _commit_floor(database_url: str, settings: Settings) -> list[float]:
     return times
 
 
+def _orm_floor(bench: Rig, warmup: int, samples: int) -> tuple[list[float], float]:
+    """The smallest transaction that records a step, through Django's ORM: a case's row locked,
+    one event appended to its log, the case updated, committed. Its times (ms) and its CPU ms
+    each (this process and PostgreSQL). The case is one started for this, never advanced."""
+    from django.db import transaction
+    from django.utils import timezone
+
+    from hrc.cases import services
+    from hrc.cases.choices import EventType
+    from hrc.cases.models import Case, CaseEvent
+
+    case_id = services.start_case(bench.signal, started_by=None).pk
+
+    def roles() -> dict[str, dict[int, float]]:
+        return {"orm": {os.getpid(): _cpu_of(os.getpid())} | _postgres_cpu()}
+
+    times: list[float] = []
+    meter: CpuMeter | None = None
+    for index in range(warmup + samples):
+        if index == warmup:
+            meter = CpuMeter(roles).start()
+        started = time.perf_counter()
+        with transaction.atomic():
+            case = Case.objects.select_for_update().get(pk=case_id)
+            case.last_seq += 1
+            CaseEvent.objects.create(
+                case=case, seq=case.last_seq, at=timezone.now(), type=EventType.TASK_STARTED
+            )
+            case.save(update_fields=["last_seq"])
+        times.append((time.perf_counter() - started) * 1000)
+    assert meter is not None  # samples >= 1
+    return times[warmup:], _ms_each(meter.stop(), "orm", samples)
+
+
 async def _opcua_floors(observer: Observer, settings: Settings) -> dict[str, list[float]]:
     """A raw write of one Int32 input register: its response, and its sight by the observer."""
     from asyncua import Client, ua
@@ -214,9 +249,12 @@ def _signalling_report(
     # request, records it before the cobot moves and moves it from a worker:
     # a request, a durable commit, a Celery hop, a write seen.
     unavoidable = ["api_request", "db_commit", "celery_dispatch", "opcua_write_seen"]
-    rows["floor_sum"] = {"of": unavoidable} | {
-        key: round(sum(rows[name][key] for name in unavoidable), 3) for key in ("p50_ms", "p99_ms")
-    }
+    # Recorded through the stack's ORM, the record is at least one transaction of that shape.
+    with_orm = ["api_request", "orm_transaction", "celery_dispatch", "opcua_write_seen"]
+    for name, parts in (("floor_sum", unavoidable), ("floor_sum_orm", with_orm)):
+        rows[name] = {"of": parts} | {
+            key: round(sum(rows[part][key] for part in parts), 3) for key in ("p50_ms", "p99_ms")
+        }
     return {
         "pattern": SIGNAL_SHAPE,
         "ours": mine,
@@ -259,10 +297,11 @@ def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 
 def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
     bench.use_workers(0)
     progress(f"throughput floors: {settings.cases} bare Celery tasks, {settings.cases} bare steps ...")  # fmt: skip
-    floors = {
-        "celery_tasks_per_second": _celery_rate(bench, settings.cases),
-        "steps_per_second": _step_rate(bench, settings.cases),
-    }
+    (tasks_per_second, task_cpu), (steps_per_second, step_cpu) = (
+        _celery_rate(bench, settings.cases), _step_rate(bench, settings.cases)
+    )  # fmt: skip
+    _, record_cpu = _orm_floor(bench, 0, settings.cases)
+    floors = {"celery_tasks_per_second": tasks_per_second, "steps_per_second": steps_per_second}
     rows = []
     for count in settings.workers:
         progress(f"throughput: {settings.cases} cases, {len(bench.cobots)} cobots, {count} worker(s) ...")  # fmt: skip
@@ -271,45 +310,61 @@ def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str],
         row["ratio_to_floors"] = {
             name: round(row["cases_per_second"] / rate, 3) for name, rate in floors.items()
         }
+    cores, floor_cpu = os.cpu_count() or 1, task_cpu + step_cpu + record_cpu
     return {
         "pattern": SIGNAL_SHAPE,
         "cobots": len(bench.cobots),
         "floors": floors,
+        # Every case needs at least one Celery task, one step, and one transaction to record
+        # it: the CPU those cost, spread over all of this machine's cores with nothing else
+        # to do, bounds any design on this stack.
+        "floor_cpu_ms": {"celery_task": task_cpu, "step": step_cpu, "orm_transaction": record_cpu},
+        "floor_cpu_bound_cases_per_second": round(cores * 1000 / floor_cpu, 1)
+        if floor_cpu
+        else None,
+        "cores": cores,
         "rows": rows,
         "target_cases_per_second": TARGET_CASES_PER_SECOND,
         "meets_target": max(row["cases_per_second"] for row in rows) >= TARGET_CASES_PER_SECOND,
     }
 
 
-def _celery_rate(bench: Rig, count: int) -> float:
+def _celery_rate(bench: Rig, count: int) -> tuple[float, float]:
     """Bare Celery tasks per second: `count` no-op tasks queued, then one floor worker (hrc's
     options) takes them all; from the first task's start to the last's (their own clocks).
+    And the CPU ms per task of the worker's processes and Redis while it did.
 
     Each case of (b) needs at least one such task.
     """
     import redis
 
     client = redis.Redis.from_url(bench.redis.url)
-    floor_app.conf.broker_url = bench.redis.url
     key = f"bench-rate-{uuid.uuid4().hex}"
-    for _ in range(count):
-        note_start.apply_async((key,))
     worker = FloorWorker(bench.workdir, bench.redis.url).start()
     try:
+        # Queued while it consumes nothing, so that its start-up is not in the CPU measured.
+        _control(floor_app.control.cancel_consumer, FLOOR_QUEUE, [worker.node])
+        for _ in range(count):
+            note_start.apply_async((key,))
+        roles = [*worker.pids(), *([bench.redis.process.pid] if bench.redis.process else [])]
+        meter = CpuMeter(lambda: {"celery": {pid: _cpu_of(pid) for pid in roles}}).start()
+        _control(floor_app.control.add_consumer, FLOOR_QUEUE, [worker.node])
         deadline = time.monotonic() + 600
         while client.llen(key) < count:
             if time.monotonic() > deadline:
                 raise RuntimeError("The floor worker did not run its tasks within 10 minutes.")
             time.sleep(0.05)
+        cpu = meter.stop()
     finally:
         worker.stop()
     starts = sorted(float(value) for value in client.lrange(key, 0, -1))
     client.delete(key)
-    return round((count - 1) / (starts[-1] - starts[0]), 1)
+    return round((count - 1) / (starts[-1] - starts[0]), 1), _ms_each(cpu, "celery", count)
 
 
-def _step_rate(bench: Rig, count: int) -> float:
-    """Zero-time steps per second through one driver to one simulated cobot, one after another.
+def _step_rate(bench: Rig, count: int) -> tuple[float, float]:
+    """Zero-time steps per second through one driver to one simulated cobot, one after another,
+    and the CPU ms per step of this process (the driver) and the gateway.
 
     Each case of (b) runs one such step; the driver is hrc's (the four-phase
     handshake with its fencing token), called from this process, nothing else around it.
@@ -319,17 +374,25 @@ def _step_rate(bench: Rig, count: int) -> float:
 
     gateway, cobot = bench.gateways[0], bench.cobots[0]
     driver = driver_for(cobot.name, gateway.endpoint, step_timeout=30.0)
+    roles = [os.getpid(), *([gateway.process.pid] if gateway.process else [])]
     try:
         steps = [StepCommand(step=STEP, fence=Fence(FLOOR_VALUES_FROM + n)) for n in range(count)]
         driver.run_step(steps[0])  # the session and its subscription
+        meter = CpuMeter(lambda: {"step": {pid: _cpu_of(pid) for pid in roles}}).start()
         started = time.perf_counter()
         for step in steps[1:]:
             result = driver.run_step(step)
             if result.outcome != "ran":
                 raise RuntimeError(f"A bare step answered {result.outcome!r}.")
-        return round((count - 1) / (time.perf_counter() - started), 1)
+        rate = round((count - 1) / (time.perf_counter() - started), 1)
+        return rate, _ms_each(meter.stop(), "step", count - 1)
     finally:
         driver.close()
+
+
+def _ms_each(cpu: Mapping[str, float] | None, role: str, count: int) -> float:
+    """A role's CPU in a CpuMeter window per operation, in ms (0 where /proc is not there)."""
+    return round(cpu[role] * 1000 / count, 3) if cpu else 0.0
 
 
 def _throughput_row(bench: Rig, cases: int, workers: int) -> dict[str, Any]:
@@ -580,8 +643,10 @@ def print_table(report: Mapping[str, Any]) -> None:
         ("floor: raw write seen by the observer", floors["opcua_write_seen"], "opcua_write_seen"),
         ("floor: bare Celery apply_async → task runs", floors["celery_dispatch"], "celery_dispatch"),
         ("floor: PostgreSQL insert, durable commit", floors["db_commit"], "db_commit"),
+        ("floor: ORM lock + event + update + commit", floors["orm_transaction"], "orm_transaction"),
         ("floor: GET /api/organisations/ via daphne", floors["api_request"], "api_request"),
         ("floor sum: request + commit + Celery + seen", floors["floor_sum"], "floor_sum"),
+        ("floor sum: the same, the commit by the ORM", floors["floor_sum_orm"], "floor_sum_orm"),
     ]  # fmt: skip
     for label, row, key in rows:
         ratios = f"   {signalling['ratio_p50'][key]:8.1f} {signalling['ratio_p99'][key]:8.1f}" if key else ""  # fmt: skip
@@ -603,6 +668,10 @@ def print_table(report: Mapping[str, Any]) -> None:
           f"   ours / floor: {', '.join(str(r['ratio_to_floors']['celery_tasks_per_second']) for r in throughput['rows'])}")  # fmt: skip
     print(f"floor: zero-time steps/s, one driver   {floors['steps_per_second']:>10.1f}"
           f"   ours / floor: {', '.join(str(r['ratio_to_floors']['steps_per_second']) for r in throughput['rows'])}")  # fmt: skip
+    cpu, bound = throughput["floor_cpu_ms"], throughput["floor_cpu_bound_cases_per_second"]
+    print(f"floor CPU per case: a bare task {cpu['celery_task']:.2f} ms (worker, Redis) + a bare step "
+          f"{cpu['step']:.2f} ms (driver, gateway) + an ORM transaction {cpu['orm_transaction']:.2f} ms "
+          f"(Django, PostgreSQL)\n  = at most {bound} cases/s on {throughput['cores']} cores, whatever the design")  # fmt: skip
     verdict = "meets" if throughput["meets_target"] else "MISSES"
     print(f"target >= {TARGET_CASES_PER_SECOND:g} cases/s: {verdict}")
 

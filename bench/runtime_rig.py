@@ -368,6 +368,8 @@ class FloorWorker:
         self.process: subprocess.Popen[bytes] | None = None
 
     def start(self, timeout: float = 60.0) -> Self:
+        """Starts the worker; this process's `floor_app` sends to it from then on."""
+        floor_app.conf.broker_url = self.broker
         command = [sys.executable, "-m", "celery", "-A", "bench.runtime_rig:floor_app", "worker",
                    "--hostname", "floor@%h", "--pool", "prefork", "--concurrency", "1",
                    "--loglevel", "INFO", "--without-gossip", "--without-mingle",
@@ -383,11 +385,25 @@ class FloorWorker:
             )
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline and self.process.poll() is None:
-            if " ready." in self.log.read_text(errors="replace"):
+            # "ready." may come before its remote control listens (Redis fans control
+            # messages out by PUBLISH: one sent earlier is lost): ready once it answers a ping.
+            if " ready." in self.log.read_text(errors="replace") and floor_app.control.ping(
+                destination=[self.node], timeout=0.5
+            ):
                 return self
             time.sleep(0.05)
         self.stop()
         raise RuntimeError(f"The floor worker did not start:\n{self.log.read_text()[-4000:]}")
+
+    @property
+    def node(self) -> str:
+        """Its name for Celery's remote control."""
+        return f"floor@{socket.gethostname()}"
+
+    def pids(self) -> set[int]:
+        from hrc.cases.launcher import process_group  # not at module level: see the docstring
+
+        return process_group(self.process.pid) if self.process is not None else set()
 
     def stop(self) -> None:
         if self.process is not None and self.process.poll() is None:

@@ -23,6 +23,14 @@ import redis
 from hrc.cobots.gateway.launcher import ROOT, free_port
 
 
+def process_group(leader: int) -> set[int]:
+    """The processes of the group `leader` leads (a worker started in a session of its own)."""
+    found = subprocess.run(
+        ["pgrep", "-g", str(leader)], capture_output=True, text=True, check=False
+    )
+    return {int(pid) for pid in found.stdout.split()}
+
+
 class RedisProcess:
     """redis-server on 127.0.0.1 with no persistence; `restart()` keeps the port (and loses the queue)."""
 
@@ -114,12 +122,7 @@ class WorkerProcess:
 
     def pids(self) -> set[int]:
         """The worker's main process and its pool children."""
-        if self.process is None:
-            return set()
-        found = subprocess.run(
-            ["pgrep", "-g", str(self.process.pid)], capture_output=True, text=True, check=False
-        )
-        return {int(pid) for pid in found.stdout.split()}
+        return process_group(self.process.pid) if self.process is not None else set()
 
     def kill(self) -> None:
         """SIGKILL to the whole worker, children included: no goodbye, no acknowledgement."""

@@ -65,11 +65,17 @@ def test_a_quick_run_writes_the_report_and_leaves_nothing_behind(tmp_path: Path)
     _positive_summary(signalling["ours"], n=QUICK["steps"])
     for row in ("http_response", "to_lease"):
         assert signalling[row]["n"] == QUICK["steps"]
-    for name in ("opcua_write", "opcua_write_seen", "celery_dispatch", "db_commit"):
-        _positive_summary(signalling["floors"][name], n=QUICK["floor_samples"])
+    floors = signalling["floors"]
+    for name in ("opcua_write", "opcua_write_seen", "celery_dispatch", "db_commit", "orm_transaction"):  # fmt: skip
+        _positive_summary(floors[name], n=QUICK["floor_samples"])
         assert signalling["ratio_p50"][name] > 0
         assert signalling["ratio_p99"][name] > 0
-    assert signalling["floors"]["floor_sum"]["p50_ms"] > 0
+    # The ORM's transaction does more than a bare commit, and the sums add their parts.
+    assert floors["orm_transaction"]["p50_ms"] > floors["db_commit"]["p50_ms"]
+    for name in ("floor_sum", "floor_sum_orm"):
+        parts = floors[name]["of"]
+        assert floors[name]["p50_ms"] == pytest.approx(sum(floors[p]["p50_ms"] for p in parts), abs=0.01)  # fmt: skip
+    assert floors["floor_sum_orm"]["p50_ms"] > floors["floor_sum"]["p50_ms"]
     assert isinstance(signalling["meets_target"], bool)
 
     throughput = report["throughput"]
@@ -77,6 +83,11 @@ def test_a_quick_run_writes_the_report_and_leaves_nothing_behind(tmp_path: Path)
     assert [row["workers"] for row in throughput["rows"]] == [1, 2]
     assert set(throughput["floors"]) == {"celery_tasks_per_second", "steps_per_second"}
     assert all(rate > 0 for rate in throughput["floors"].values())
+    cpu = throughput["floor_cpu_ms"]
+    assert set(cpu) == {"celery_task", "step", "orm_transaction"}
+    assert all(ms > 0 for ms in cpu.values())
+    bound = throughput["cores"] * 1000 / sum(cpu.values())
+    assert throughput["floor_cpu_bound_cases_per_second"] == pytest.approx(bound, abs=0.1)
     for row in throughput["rows"]:
         assert row["cases"] == QUICK["cases"]
         assert row["cases_per_second"] > 0
