@@ -296,7 +296,7 @@ def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 
 
 def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
     bench.use_workers(0)
-    progress(f"throughput floors: {settings.cases} bare Celery tasks, {settings.cases} bare steps ...")  # fmt: skip
+    progress(f"throughput floors: {settings.cases} bare Celery tasks, steps, ORM transactions ...")  # fmt: skip
     (tasks_per_second, task_cpu), (steps_per_second, step_cpu) = (
         _celery_rate(bench, settings.cases), _step_rate(bench, settings.cases)
     )  # fmt: skip
@@ -311,6 +311,7 @@ def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str],
             name: round(row["cases_per_second"] / rate, 3) for name, rate in floors.items()
         }
     cores, floor_cpu = os.cpu_count() or 1, task_cpu + step_cpu + record_cpu
+    bound = round(cores * 1000 / floor_cpu, 1) if floor_cpu else None  # None: no /proc
     return {
         "pattern": SIGNAL_SHAPE,
         "cobots": len(bench.cobots),
@@ -319,9 +320,7 @@ def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str],
         # it: the CPU those cost, spread over all of this machine's cores with nothing else
         # to do, bounds any design on this stack.
         "floor_cpu_ms": {"celery_task": task_cpu, "step": step_cpu, "orm_transaction": record_cpu},
-        "floor_cpu_bound_cases_per_second": round(cores * 1000 / floor_cpu, 1)
-        if floor_cpu
-        else None,
+        "floor_cpu_bound_cases_per_second": bound,
         "cores": cores,
         "rows": rows,
         "target_cases_per_second": TARGET_CASES_PER_SECOND,
@@ -669,9 +668,10 @@ def print_table(report: Mapping[str, Any]) -> None:
     print(f"floor: zero-time steps/s, one driver   {floors['steps_per_second']:>10.1f}"
           f"   ours / floor: {', '.join(str(r['ratio_to_floors']['steps_per_second']) for r in throughput['rows'])}")  # fmt: skip
     cpu, bound = throughput["floor_cpu_ms"], throughput["floor_cpu_bound_cases_per_second"]
-    print(f"floor CPU per case: a bare task {cpu['celery_task']:.2f} ms (worker, Redis) + a bare step "
-          f"{cpu['step']:.2f} ms (driver, gateway) + an ORM transaction {cpu['orm_transaction']:.2f} ms "
-          f"(Django, PostgreSQL)\n  = at most {bound} cases/s on {throughput['cores']} cores, whatever the design")  # fmt: skip
+    if bound is not None:
+        print(f"floor CPU per case: a bare task {cpu['celery_task']:.2f} ms (worker, Redis) + a bare step "
+              f"{cpu['step']:.2f} ms (driver, gateway) + an ORM transaction {cpu['orm_transaction']:.2f} ms "
+              f"(Django, PostgreSQL)\n  = at most {bound} cases/s on {throughput['cores']} cores, whatever the design")  # fmt: skip
     verdict = "meets" if throughput["meets_target"] else "MISSES"
     print(f"target >= {TARGET_CASES_PER_SECOND:g} cases/s: {verdict}")
 
