@@ -148,6 +148,14 @@ class CobotData(TypedDict):
     queue: CobotQueueData
 
 
+class FloorCobot(TypedDict):
+    """Where one of the organisation's cobots stands: how a cell's tablet names another cell."""
+
+    id: int
+    name: str
+    cell: str
+
+
 class CellStopData(TypedDict):
     id: int
     cell: str  # "" for the whole organisation
@@ -185,7 +193,8 @@ class Snapshot(TypedDict):
     cases: list[CaseData]
     work_items: list[WorkItemData]
     incidents: list[IncidentData]
-    cobots: list[CobotData]
+    cobots: list[CobotData]  # the tablet's cell's cobots (every one for the whole floor)
+    floor: list[FloorCobot]  # every cobot of the organisation, by id
     stop: CellStopData | None  # the cell's STOP while it holds
 
 

@@ -24,6 +24,7 @@ from hrc.live.events import (
     CobotData,
     CobotQueueData,
     CurrentStep,
+    FloorCobot,
     IncidentData,
     Snapshot,
     WorkItemData,
@@ -77,10 +78,13 @@ def snapshot(access: Access, cell: str) -> Snapshot:
     organisation = access.organisation_id
     cases, mappings = _open_cases(organisation)
     case_ids = [case["id"] for case in cases]
-    cobots = Cobot.objects.filter(organisation_id=organisation).order_by("name")
-    if cell:
-        cobots = cobots.filter(cell=cell)
-    cobot_rows = list(cobots.values("id", "name", "cell", "stopped_at"))
+    # Every cobot of the organisation: its cell's tablet shows some, and names the others' cells.
+    floor = list(
+        Cobot.objects.filter(organisation_id=organisation)
+        .order_by("name")
+        .values("id", "name", "cell", "stopped_at")
+    )
+    cobot_rows = [row for row in floor if not cell or row["cell"] == cell]
     ids = [row["id"] for row in cobot_rows]
     queues = {data["cobot"]: data for _, _, data in cobot_queues(ids)}
     states = cobot_states.recall(ids)
@@ -110,6 +114,10 @@ def snapshot(access: Access, cell: str) -> Snapshot:
                 queue=queues[row["id"]],
             )
             for row in cobot_rows
+        ],
+        "floor": [
+            FloorCobot(id=row["id"], name=row["name"], cell=row["cell"])
+            for row in sorted(floor, key=lambda row: row["id"])
         ],
         "stop": active_stop(organisation, cell),
     }

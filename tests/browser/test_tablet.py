@@ -317,7 +317,7 @@ def test_the_tablet_fits_a_ten_inch_tablet_both_ways(
     assert re.search(r"Cell A", page.locator("header.site").inner_text())
 
 
-def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_elsewhere(
+def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_at_which_cells(
     server: LiveServer,
     tablet: BrowserContext,
     operator: User,
@@ -342,23 +342,23 @@ def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_elsewhere
     cards = page.locator(".cards.mine .card")
     expect(cards).to_have_count(1)
     expect(cards).to_have_attribute("data-item", str(at_weld.pk))
-    expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at other cells.")
+    expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at the paint cell.")
     screenshot(page, "tablet-cell-scoped")
 
     # Live, no reload: a new case at the paint cell only adds to the count; the operator's
     # paint task, once started from the floor, is theirs here too.
     start(paint)
     broadcast.flush()
-    expect(page.locator(".elsewhere")).to_have_text("2 more tasks wait for you at other cells.")
+    expect(page.locator(".elsewhere")).to_have_text("2 more tasks wait for you at the paint cell.")
     expect(cards).to_have_count(1)
     case_services.start_work_item(at_paint, user=operator)
     broadcast.flush()
     expect(cards).to_have_count(2)
     away = page.locator(f'.card[data-item="{at_paint.pk}"]')
     expect(away).to_have_attribute("data-state", "running")
-    expect(away.locator(".away")).to_have_text("At another cell: go there to do it.")
+    expect(away.locator(".away")).to_have_text("At the paint cell: go there to do it.")
     expect(page.locator(f'.card[data-item="{at_weld.pk}"] .away')).to_have_count(0)
-    expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at other cells.")
+    expect(page.locator(".elsewhere")).to_have_text("1 more task waits for you at the paint cell.")
 
     page.goto(f"{server.url}/tablet/")  # the whole floor: every task, nothing elsewhere
     expect(page.locator(".cards.mine .card")).to_have_count(3)

@@ -1,4 +1,4 @@
-"""What the tablets read: a cobot's queue, as its panel shows it."""
+"""What the tablets read: a cobot's queue, as its panel shows it; where the floor's cobots stand."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from django.contrib.auth.models import User
 from hrc.cases import jobs
 from hrc.cases.models import Job
 from hrc.cobots.models import Cobot
-from hrc.live.selectors import cobot_queues
+from hrc.live.selectors import access_of, cobot_queues, snapshot
 from hrc.organisations.models import Organisation
 from tests import factories
 
@@ -52,3 +52,24 @@ def test_a_cobots_queue_counts_its_jobs_names_the_running_step_and_the_first_rea
         "task": "tc1", "label": "place insert", "kind": "step",
         "step": running.command["number"], "attempt": 1,
     }  # fmt: skip
+
+
+def test_a_cell_tablet_gets_its_cells_cobots_and_where_every_other_cobot_of_ours_stands(
+    organisation: Organisation, other_organisation: Organisation, operator: User
+) -> None:
+    weld = factories.make_cobot(organisation, name="weld-arm", cell="weld")
+    paint = factories.make_cobot(organisation, name="paint-arm", cell="paint")
+    loose = factories.make_cobot(organisation, name="spare")
+    factories.make_cobot(other_organisation, name="their-arm", cell="weld")
+    access = access_of(operator, organisation.pk)
+    assert access is not None
+
+    weld_tablet = snapshot(access, "weld")
+
+    assert [cobot["id"] for cobot in weld_tablet["cobots"]] == [weld.pk]
+    assert weld_tablet["floor"] == [
+        {"id": weld.pk, "name": "weld-arm", "cell": "weld"},
+        {"id": paint.pk, "name": "paint-arm", "cell": "paint"},
+        {"id": loose.pk, "name": "spare", "cell": ""},
+    ]  # by id; nothing of the other organisation
+    assert snapshot(access, "")["floor"] == weld_tablet["floor"]

@@ -110,6 +110,13 @@ export interface CobotData {
   queue: CobotQueueData;
 }
 
+/** Where one of the organisation's cobots stands: how a cell's tablet names another cell. */
+export interface FloorCobot {
+  id: number;
+  name: string;
+  cell: string;
+}
+
 export interface CellStopData {
   id: number;
   cell: string;
@@ -143,6 +150,7 @@ export interface Snapshot {
   work_items: WorkItemData[];
   incidents: IncidentData[];
   cobots: CobotData[];
+  floor: FloorCobot[];
   stop: CellStopData | null;
 }
 

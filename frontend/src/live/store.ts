@@ -14,6 +14,7 @@ import type {
   CobotData,
   CobotQueueData,
   CobotStateData,
+  FloorCobot,
   IncidentData,
   LiveEvent,
   Snapshot,
@@ -32,6 +33,8 @@ export interface LiveState {
   workItems: Map<number, WorkItemData>;
   incidents: Map<number, IncidentData>;
   cobots: Map<number, CobotData>;
+  // Every cobot of the organisation, with its cell, as of the snapshot.
+  floor: Map<number, FloorCobot>;
   stop: CellStopData | null;
 }
 
@@ -99,6 +102,7 @@ export class LiveStore {
       workItems: new Map(snapshot.work_items.map((w) => [w.id, w])),
       incidents: new Map(snapshot.incidents.map((i) => [i.id, i])),
       cobots: new Map(snapshot.cobots.map((c) => [c.id, c])),
+      floor: new Map(snapshot.floor.map((c) => [c.id, c])),
       stop: snapshot.stop,
     };
   }
@@ -218,6 +222,7 @@ export function asSnapshot(state: LiveState): Omit<Snapshot, "type"> {
     work_items: byId(state.workItems.values()),
     incidents: byId(state.incidents.values()),
     cobots: byId(state.cobots.values()),
+    floor: byId(state.floor.values()),
     stop: state.stop,
   };
 }

@@ -6,7 +6,19 @@ import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
 import { ApiError, request } from "./api";
 import { type FormSchema, renderForm } from "./form";
-import { activity, atThisCell, cobotsOf, degrees, elsewhere, humanSafety, myTasks, nextAction, teamTasks } from "./view";
+import {
+  activity,
+  atThisCell,
+  cellsOf,
+  cellWords,
+  cobotsOf,
+  degrees,
+  elsewhere,
+  humanSafety,
+  myTasks,
+  nextAction,
+  teamTasks,
+} from "./view";
 
 interface Config {
   organisation: number;
@@ -65,9 +77,10 @@ function render(): void {
 function renderElsewhere(state: LiveState): void {
   const note = root.querySelector<HTMLElement>(".elsewhere");
   if (!note) return; // the whole floor's tablet shows every task
-  const count = elsewhere(state);
+  const items = elsewhere(state);
+  const count = items.length;
   note.hidden = count === 0;
-  note.textContent = `${count} more ${count === 1 ? "task waits" : "tasks wait"} for you at other cells.`;
+  note.textContent = `${count} more ${count === 1 ? "task waits" : "tasks wait"} for you at ${cellWords(cellsOf(state, items), true)}.`;
 }
 
 function renderCards(container: HTMLElement, items: WorkItemData[], state: LiveState, empty: string): void {
@@ -88,7 +101,10 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     element("p", "meta", `${caseName ? `${caseName} · ` : ""}case ${item.case} · ${item.state}`),
   );
   // Only a task the operator holds shows up here from another cell: say so, or they wait in vain.
-  if (!atThisCell(state, item)) article.append(element("p", "away", "At another cell: go there to do it."));
+  if (!atThisCell(state, item)) {
+    const where = cellWords(cellsOf(state, [item]));
+    article.append(element("p", "away", `At ${where}: go there to do it.`));
+  }
   if (item.instructions) article.append(element("p", "instructions", item.instructions));
   const cobots = cobotsOf(state, item);
   if (cobots.length) {

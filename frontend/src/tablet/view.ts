@@ -18,11 +18,33 @@ export function teamTasks(state: LiveState): WorkItemData[] {
   return sorted([...state.workItems.values()].filter((item) => isTeams(state, item) && atThisCell(state, item)));
 }
 
-/** How many tasks the user could take that a cell's tablet leaves out: they wait at other cells. */
-export function elsewhere(state: LiveState): number {
-  return [...state.workItems.values()].filter(
-    (item) => item.claimed_by === null && (isMine(state, item) || isTeams(state, item)) && !atThisCell(state, item),
-  ).length;
+/** The tasks the user could take that a cell's tablet leaves out: they wait at other cells. */
+export function elsewhere(state: LiveState): WorkItemData[] {
+  return sorted(
+    [...state.workItems.values()].filter(
+      (item) => item.claimed_by === null && (isMine(state, item) || isTeams(state, item)) && !atThisCell(state, item),
+    ),
+  );
+}
+
+/** The cells the items' cases work at, by name: where an operator goes to do them. Empty when
+ * none is known (a cobot registered after the snapshot, one that stands in no cell). */
+export function cellsOf(state: LiveState, items: WorkItemData[]): string[] {
+  const cells = new Set<string>();
+  for (const item of items) {
+    for (const id of state.cases.get(item.case)?.cobots ?? []) {
+      const cell = state.floor.get(id)?.cell;
+      if (cell) cells.add(cell);
+    }
+  }
+  return [...cells].sort();
+}
+
+/** "the paint cell", "the paint and weld cells"; "another cell" when none is known. */
+export function cellWords(cells: string[], many = false): string {
+  if (!cells.length) return many ? "other cells" : "another cell";
+  if (cells.length === 1) return `the ${cells[0]} cell`;
+  return `the ${cells.slice(0, -1).join(", ")} and ${cells[cells.length - 1]} cells`;
 }
 
 /** Whether the item's case works at this tablet's cell. A tablet of the whole floor (no cell)

@@ -19,6 +19,7 @@ export function snapshot(overrides: Partial<Snapshot> = {}): Snapshot {
         queue: { cobot: 5, at: 1, queue_length: 0, current: null, waiting_for: "" },
       },
     ],
+    floor: [{ id: 5, name: "cobot1", cell: "" }],
     stop: null,
     ...overrides,
   };

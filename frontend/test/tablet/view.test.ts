@@ -1,7 +1,7 @@
 import { describe, expect, it } from "vitest";
 import type { Snapshot } from "../../src/live/events";
 import { type LiveState, LiveStore } from "../../src/live/store";
-import { atThisCell, elsewhere, myTasks, teamTasks } from "../../src/tablet/view";
+import { atThisCell, cellsOf, cellWords, elsewhere, myTasks, teamTasks } from "../../src/tablet/view";
 import { item, snapshot } from "../live/fixtures";
 
 const WELD_ARM = {
@@ -27,6 +27,10 @@ function floor(cell: string, overrides: Partial<Snapshot> = {}): LiveState {
       ],
       work_items: [item({ id: 101, case: 10 }), item({ id: 111, case: 11 }), item({ id: 121, case: 12 })],
       cobots: cell ? [WELD_ARM] : [WELD_ARM, { ...WELD_ARM, id: 6, name: "paint-arm", cell: "paint" }],
+      floor: [
+        { id: 5, name: "weld-arm", cell: "weld" },
+        { id: 6, name: "paint-arm", cell: "paint" },
+      ],
       ...overrides,
     }),
   );
@@ -40,7 +44,8 @@ describe("a cell's tablet", () => {
     const state = floor("weld");
     expect(ids(myTasks(state))).toEqual([101, 121]);
     expect(atThisCell(state, state.workItems.get(111)!)).toBe(false);
-    expect(elsewhere(state)).toBe(1);
+    expect(ids(elsewhere(state))).toEqual([111]);
+    expect(cellsOf(state, elsewhere(state))).toEqual(["paint"]);
   });
 
   it("keeps a task the user holds in another cell: theirs to finish", () => {
@@ -48,7 +53,22 @@ describe("a cell's tablet", () => {
       work_items: [item({ id: 111, case: 11, state: "running", claimed_by: 7, candidates: [7] })],
     });
     expect(ids(myTasks(state))).toEqual([111]);
-    expect(elsewhere(state)).toBe(0);
+    expect(cellsOf(state, myTasks(state))).toEqual(["paint"]);
+    expect(elsewhere(state)).toEqual([]);
+  });
+
+  it("names no cell for a case whose cobots it does not know, or that stand in no cell", () => {
+    const state = floor("weld", {
+      cases: [
+        { id: 11, seq: 2, status: "running", name: "Paint", cobots: [6, 9] },
+        { id: 13, seq: 2, status: "running", name: "New", cobots: [9] },
+      ],
+      work_items: [item({ id: 111, case: 11 }), item({ id: 131, case: 13 })],
+      floor: [{ id: 6, name: "paint-arm", cell: "paint" }],
+    });
+    expect(ids(elsewhere(state))).toEqual([111, 131]);
+    expect(cellsOf(state, [state.workItems.get(131)!])).toEqual([]);
+    expect(cellsOf(state, elsewhere(state))).toEqual(["paint"]);
   });
 
   it("scopes team tasks the same way, and counts them among those waiting elsewhere", () => {
@@ -58,14 +78,14 @@ describe("a cell's tablet", () => {
     });
     expect(ids(teamTasks(state))).toEqual([101]);
     expect(ids(myTasks(state))).toEqual([]);
-    expect(elsewhere(state)).toBe(1);
+    expect(ids(elsewhere(state))).toEqual([111]);
   });
 
   it("does not count what someone else took or what is not offered to the user", () => {
     const state = floor("weld", {
       work_items: [item({ id: 111, case: 11, state: "claimed", claimed_by: 8 }), item({ id: 112, case: 11, candidates: [8] })],
     });
-    expect(elsewhere(state)).toBe(0);
+    expect(elsewhere(state)).toEqual([]);
   });
 });
 
@@ -73,6 +93,15 @@ describe("the whole floor's tablet", () => {
   it("offers every case's tasks and has nothing elsewhere", () => {
     const state = floor("");
     expect(ids(myTasks(state))).toEqual([101, 111, 121]);
-    expect(elsewhere(state)).toBe(0);
+    expect(elsewhere(state)).toEqual([]);
+  });
+});
+
+describe("cell words", () => {
+  it("name one cell, several, or none known", () => {
+    expect(cellWords(["paint"])).toBe("the paint cell");
+    expect(cellWords(["assembly", "paint", "weld"], true)).toBe("the assembly, paint and weld cells");
+    expect(cellWords([])).toBe("another cell");
+    expect(cellWords([], true)).toBe("other cells");
   });
 });
