@@ -44,6 +44,7 @@ FULL = PAIRS | {
     "task-offered": "schedule",
     "task-claimed": "assign",
     "task-unclaimed": "reassign",  # back to the candidates, for someone else to take
+    "task-reassigned": "reassign",  # by a supervisor, to someone or back to the candidates
     "task-interrupted": "suspend",
     "task-resumed": "resume",
     "task-withdrawn": "withdraw",  # "ate_abort" once the task had started

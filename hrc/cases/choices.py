@@ -83,6 +83,8 @@ class EventType(models.TextChoices):
     TASK_OFFERED = "task-offered", "Task offered"
     TASK_CLAIMED = "task-claimed", "Task claimed"
     TASK_UNCLAIMED = "task-unclaimed", "Task unclaimed"
+    # A supervisor gave a task to another operator, or back to its candidates.
+    TASK_REASSIGNED = "task-reassigned", "Task reassigned"
     TASK_STARTED = "task-started", "Task started"
     TASK_COMPLETED = "task-completed", "Task completed"
     TASK_WITHDRAWN = "task-withdrawn", "Task withdrawn"

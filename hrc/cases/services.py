@@ -172,6 +172,53 @@ def unclaim_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
     return item
 
 
+def reassign_work_item(item: WorkItem, *, by: User, to: User | None) -> WorkItem:
+    """Hands an operator task to `to`, or gives a claimed one back to its candidates (`to` None):
+    what a supervisor does when the operator who holds it has gone. A started task stays
+    started, with its new holder, who completes it. The API lets engineers and admins only.
+
+    Invalid when `to` may not perform it (not a candidate, not in its team, not a member);
+    Conflict when it has ended, or a started task would be left with nobody to finish it.
+    """
+    from hrc.cases.selectors import performable_by
+
+    with transaction.atomic():
+        case = lock_case(item.case_id)
+        item = WorkItem.objects.select_related("claimed_by").get(pk=item.pk)
+        _check_open(case)
+        if item.kind != WorkItemKind.OPERATOR:
+            raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+        if item.state not in OPEN_WORK_ITEM_STATES:
+            raise Conflict(_moved_on(item, "reassigned"))
+        holder = item.claimed_by
+        if to is None:
+            if item.state == WorkItemState.OFFERED:
+                raise Conflict(f"Nobody holds {item.label}: name who should do it.")
+            if item.state == WorkItemState.RUNNING:
+                raise Conflict(f"{item.label} has started: name who finishes it.")
+            item.state, item.claimed_by = WorkItemState.OFFERED, None
+        else:
+            may = WorkItem.objects.filter(
+                performable_by(to), pk=item.pk, case__organisation__memberships__user_id=to.pk
+            )
+            if not may.exists():
+                raise Invalid(f"{to.get_username()} may not do {item.label}: not among its candidates or in its team.")  # fmt: skip
+            if holder is not None and holder.pk == to.pk:
+                raise Conflict(f"{to.get_username()} holds {item.label} already.")
+            if item.state == WorkItemState.OFFERED:
+                item.state = WorkItemState.CLAIMED
+            item.claimed_by = to
+        item.save(update_fields=["state", "claimed_by"])
+        record_event(
+            case, EventType.TASK_REASSIGNED, item=item, user=by,
+            detail={"from": holder.get_username() if holder else None,
+                    "to": to.get_username() if to else None},
+        )  # fmt: skip
+        case.save()
+    item.case = case  # what the API's answer reads
+    return item
+
+
 def start_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
     """Starts an operator task (claiming it if nobody has); the other tasks of a choice withdraw."""
     with transaction.atomic():

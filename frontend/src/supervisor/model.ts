@@ -105,6 +105,7 @@ export const EVENT_NAMES: Record<string, string> = {
   "task-offered": "Task offered",
   "task-claimed": "Task claimed",
   "task-unclaimed": "Task unclaimed",
+  "task-reassigned": "Task reassigned",
   "task-started": "Task started",
   "task-completed": "Task completed",
   "task-withdrawn": "Task withdrawn",

@@ -182,6 +182,14 @@ class WorkItemDetailSerializer(WorkItemSerializer):
         return dict(config.form) if config is not None and config.form is not None else None
 
 
+class ReassignRequestSerializer(serializers.Serializer[dict[str, Any]]):
+    user = serializers.IntegerField(
+        allow_null=True,
+        help_text="Who does the task now: a member who may (a candidate, or in its team). "
+        "null gives a claimed task back to its candidates.",
+    )
+
+
 class CompleteRequestSerializer(serializers.Serializer[dict[str, Any]]):
     def get_fields(self) -> dict[str, serializers.Field[Any, Any, Any, Any]]:
         # Declared here: a class attribute named `data` would shadow Serializer.data.

@@ -12,6 +12,7 @@ client as 400, 403 or 409 with a `detail` (hrc.api.exceptions).
 import re
 from typing import Any
 
+from django.contrib.auth.models import User
 from django.db.models import QuerySet
 from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_view
 from rest_framework import generics, mixins, serializers, status, viewsets
@@ -36,6 +37,7 @@ from hrc.cases.api.serializers import (
     MessageRequestSerializer,
     MessageSerializer,
     QueuedJobSerializer,
+    ReassignRequestSerializer,
     RefusalSerializer,
     ResolveRequestSerializer,
     StartCaseRequestSerializer,
@@ -244,6 +246,32 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
         item = services.complete_work_item(
             _item_id(pk), user=_user(request), data=body.validated_data.get("data")
         )
+        return Response(self._detail(item))
+
+    @extend_schema(
+        request=ReassignRequestSerializer,
+        responses={200: WorkItemDetailSerializer, **WRITE_REFUSALS},
+    )
+    @action(detail=True, methods=["post"])
+    def reassign(self, request: Request, pk: str | None = None) -> Response:
+        """Hands a task someone holds, or an offered one, to another operator who may do it; or
+        gives a claimed one back to its candidates (`user`: null). Engineers and admins: for when
+        the operator who holds it has gone. A started task stays started, with its new holder."""
+        item = selectors.work_items_visible_to(request.user).filter(pk=_item_id(pk)).first()
+        if item is None:
+            raise NotFound(f"There is no work item {pk} in your organisations.")
+        organisation = item.case.organisation_id
+        if not may_write_in(request.user, organisation):
+            raise PermissionDenied(WRITERS_ONLY)
+        body = ReassignRequestSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        wanted, to = body.validated_data["user"], None
+        if wanted is not None:
+            # Only members are found: an id from another organisation names nobody here.
+            to = User.objects.filter(pk=wanted, memberships__organisation_id=organisation).first()
+            if to is None:
+                raise Rejected({"detail": f"There is no user {wanted} in this organisation."})
+        item = services.reassign_work_item(item, by=_user(request), to=to)
         return Response(self._detail(item))
 
     @staticmethod
