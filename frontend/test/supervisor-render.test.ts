@@ -111,14 +111,23 @@ describe("tables", () => {
   it("lists the open tasks, or says there are none", () => {
     document.body.innerHTML = "<table><tbody></tbody></table>";
     const body = document.querySelector("tbody")!;
-    renderWorkRows(body, [{ task: "tc1", label: "pick", state: "offered", who: "cobot1", job: "queued, position 1" }]);
+    const step = { task: "tc1", label: "pick", state: "offered", who: "cobot1", job: "queued, position 1" };
+    const held = { task: "to1", label: "place", state: "claimed", who: "olivia", job: "", id: 8 };
+    renderWorkRows(body, [
+      { ...step, id: 7, reassignable: false },
+      { ...held, reassignable: true },
+    ]);
     expect(body.querySelector("tr")!.dataset.task).toBe("tc1");
-    expect([...body.querySelectorAll("td")].map((td) => td.textContent)).toEqual([
+    expect([...body.querySelectorAll("tr:first-child td")].map((td) => td.textContent)).toEqual([
       "pick tc1",
       "offered",
       "cobot1",
       "queued, position 1",
+      "",
     ]);
+    const button = body.querySelector<HTMLButtonElement>("tr:last-child button[data-reassign]")!;
+    expect({ ...button.dataset }).toEqual({ reassign: "8", state: "claimed", label: "place", who: "olivia" });
+    expect(body.querySelectorAll("button[data-reassign]")).toHaveLength(1);
     renderWorkRows(body, []);
     expect(body.textContent).toBe("No open tasks.");
   });

@@ -158,6 +158,16 @@ describe("open tasks", () => {
     expect(workRow(item("tc1", "offered", { job })).who).toBe("cobot1");
     expect(workRow(item("t", "offered"))).toMatchObject({ who: "–", label: "t", job: "" });
   });
+
+  it("offers to hand over an operator task, never a cobot's", () => {
+    expect(["offered", "claimed", "running"].map((state) => workRow(item("t", state)).reassignable)).toEqual([
+      true,
+      true,
+      true,
+    ]);
+    expect(workRow(item("tc1", "offered", { kind: "step", job })).reassignable).toBe(false);
+    expect(workRow(item("t", "completed")).reassignable).toBe(false);
+  });
 });
 
 describe("resolving an incident", () => {

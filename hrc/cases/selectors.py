@@ -6,6 +6,7 @@ empty querysets (and the API 404s) whatever ids they try.
 
 from collections.abc import Iterable
 
+from django.contrib.auth.models import User
 from django.db.models import Case as SqlCase
 from django.db.models import (
     Count,
@@ -82,6 +83,22 @@ def performable_by(user: AnyUser) -> Q:
         team_id=OuterRef("team_id"), membership__user_id=user.pk
     )
     return Q(kind=WorkItemKind.OPERATOR) & (Q(Exists(candidate)) | Q(Exists(in_team)))
+
+
+def performers_of(item: WorkItem) -> QuerySet[User]:
+    """The active members who may do an operator work item, by name: its candidates, and the
+    members of its team (performable_by's rule, from the item's side)."""
+    may = Q(
+        pk__in=WorkItem.candidates.through.objects.filter(workitem_id=item.pk).values("user_id")
+    )
+    if item.team_id is not None:
+        may |= Q(memberships__teams__id=item.team_id)
+    organisation = item.case.organisation_id
+    return (
+        User.objects.filter(may, is_active=True, memberships__organisation_id=organisation)
+        .distinct()
+        .order_by("username")
+    )
 
 
 def task_list(user: AnyUser, kinds: Iterable[str] = (WorkItemKind.OPERATOR,)) -> QuerySet[WorkItem]:

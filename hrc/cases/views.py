@@ -32,6 +32,7 @@ from hrc.cases.choices import (
     CaseStatus,
     EventType,
     JobState,
+    WorkItemKind,
     WorkItemState,
 )
 from hrc.cases.drawing import ConstraintLine, NetDrawing, Node, draw_net
@@ -191,6 +192,7 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
                 "events": reverse("case-events", args=[case.pk]),
                 "incidents": f"{reverse('incident-list')}?case={case.pk}&all=1",
                 "resolve": reverse("incident-resolve", args=[0]),
+                "workItems": reverse("work-item-list"),
             },
         },
     }
@@ -204,6 +206,8 @@ class WorkRow:
     state: str
     who: str
     job: str
+    id: int
+    reassignable: bool  # an operator task still open: a supervisor may hand it over
 
 
 def work_row(item: WorkItem) -> WorkRow:
@@ -212,7 +216,9 @@ def work_row(item: WorkItem) -> WorkRow:
     who = item.claimed_by.get_username() if item.claimed_by else ""
     if not who and item.cobot is not None:
         who = item.cobot.name
-    return WorkRow(item.task, item.label or item.task, item.state, who or "–", _job_text(item, job))
+    reassignable = item.kind == WorkItemKind.OPERATOR and item.state in OPEN_WORK_ITEM_STATES
+    label = item.label or item.task
+    return WorkRow(item.task, label, item.state, who or "–", _job_text(item, job), item.pk, reassignable)  # fmt: skip
 
 
 def _job_text(item: WorkItem, job: Job | None) -> str:

@@ -99,6 +99,41 @@ def test_an_engineer_follows_a_running_case_on_its_net_and_timeline(
     screenshot(page, "supervisor-case-moved-on")
 
 
+def test_an_engineer_hands_a_started_task_to_a_colleague_when_its_operator_has_gone(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    operator: User,
+    choice_version: Any,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    colleague = factories.make_member(engineer.memberships.get().organisation, Role.OPERATOR, "carl-colleague")  # fmt: skip
+    mapping = {"o": {"users": [operator.pk, colleague.pk]}}
+    case = factories.make_case(choice_version, started_by=engineer, actor_mapping=mapping)
+    count = factories.open_work_item(case, "count")
+    services.start_work_item(count, user=operator)
+    sign_in(page, engineer)
+    page.goto(f"{live_url}/cases/{case.pk}/")
+
+    row = page.locator('#work-items tr[data-task="count"]')
+    expect(row).to_contain_text("olivia-operator")
+    row.get_by_role("button", name="Hand over…").click()
+    dialog = page.locator("dialog#reassign")
+    expect(dialog).to_be_visible()
+    expect(dialog.locator("h3")).to_have_text("Hand over count parts")
+    # A started task cannot go back to nobody, nor to the one who has it.
+    expect(dialog.locator("option")).to_have_text(["carl-colleague"])
+    screenshot(page, "supervisor-hand-over")
+    dialog.get_by_role("button", name="Hand over").click()
+
+    expect(dialog).to_be_hidden()
+    expect(row).to_contain_text("carl-colleague", timeout=LIVE)
+    expect(page.locator("#timeline tbody tr").first).to_contain_text("Task reassigned")
+    count.refresh_from_db()
+    assert (count.state, count.claimed_by) == ("running", colleague)
+
+
 def test_an_engineer_skips_a_failed_step_with_its_outputs(
     page: Page,
     live_url: str,

@@ -1,5 +1,6 @@
 // The supervisor pages' script (templates/cases/): keeps the case page's marking, open
-// tasks, incidents and timeline up to date, and resolves incidents through the REST API.
+// tasks, incidents and timeline up to date, resolves incidents and hands tasks over through
+// the REST API.
 //
 // The live socket (/ws/live/, hrc/live/) is the doorbell: a delta about the page's case
 // (or any incident, on the incidents page) makes the page read the REST API again; the
@@ -55,7 +56,7 @@ interface CasePageConfig {
   lastSeq: number;
   live: boolean;
   labels: Record<string, string>;
-  api: { case: string; events: string; incidents: string; resolve: string };
+  api: { case: string; events: string; incidents: string; resolve: string; workItems: string };
 }
 
 interface IncidentsPageConfig {
@@ -195,6 +196,68 @@ function onResolve(resolveUrl: string, after: () => Promise<void>): void {
   });
 }
 
+// Handing over a task whose operator has gone -----------------------------------------------
+
+interface Performer {
+  id: number;
+  username: string;
+}
+
+/** A task's "Hand over…" opens the dialog with whom it may go to (the API's performers, but the
+ * one who holds it; a claimed task may also go back to its candidates). */
+function onReassign(workItemsUrl: string, after: () => Promise<void>): void {
+  const dialog = document.querySelector<HTMLDialogElement>("dialog#reassign");
+  const form = dialog?.querySelector("form");
+  const select = dialog?.querySelector<HTMLSelectElement>('select[name="user"]');
+  const errors = dialog?.querySelector<HTMLElement>(".errors");
+  const handOver = dialog?.querySelector<HTMLButtonElement>('button[value="hand-over"]');
+  if (!dialog || !form || !select || !errors || !handOver) return;
+  let item = 0;
+
+  document.addEventListener("click", (event) => {
+    const button = (event.target as Element | null)?.closest<HTMLButtonElement>("button[data-reassign]");
+    if (!button) return;
+    item = Number(button.dataset.reassign);
+    dialog.querySelector(".what")!.textContent = button.dataset.label ?? "";
+    errors.textContent = "";
+    button.disabled = true;
+    getJson<Performer[]>(`${workItemsUrl}${item}/performers/`)
+      .then((performers) => {
+        const options = performers
+          .filter((performer) => performer.username !== button.dataset.who)
+          .map((performer) => new Option(performer.username, String(performer.id)));
+        if (button.dataset.state === "claimed") options.unshift(new Option("Back to its candidates", ""));
+        select.replaceChildren(...options);
+        if (!options.length) errors.textContent = "Nobody else may do this task.";
+      })
+      .catch((error: unknown) => {
+        select.replaceChildren();
+        errors.textContent = error instanceof Refusal ? error.message : String(error);
+      })
+      .finally(() => {
+        button.disabled = false;
+        handOver.disabled = select.options.length === 0;
+        dialog.showModal();
+      });
+  });
+
+  form.addEventListener("submit", (event) => {
+    if ((event as SubmitEvent).submitter !== handOver) return; // Cancel closes the dialog
+    event.preventDefault();
+    handOver.disabled = true;
+    const user = select.value ? Number(select.value) : null;
+    postJson(`${workItemsUrl}${item}/reassign/`, { user }, csrfToken())
+      .then(() => {
+        dialog.close();
+        void after();
+      })
+      .catch((error: unknown) => {
+        errors.textContent = error instanceof Refusal ? error.message : String(error);
+      })
+      .finally(() => (handOver.disabled = false));
+  });
+}
+
 // The case page -----------------------------------------------------------------------------
 
 async function allEventsAfter(url: string, after: number): Promise<EventJson[]> {
@@ -271,6 +334,7 @@ function startCasePage(config: CasePageConfig): void {
   const refresher = new Refresher(refresh);
   refresher.listen(config, (event) => concernsCase(event, config.case));
   onResolve(config.api.resolve, () => refresher.request());
+  onReassign(config.api.workItems, () => refresher.request());
 }
 
 // The incidents page ------------------------------------------------------------------------

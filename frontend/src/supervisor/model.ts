@@ -170,7 +170,11 @@ export interface WorkRow {
   state: string;
   who: string;
   job: string;
+  id: number;
+  reassignable: boolean; // an operator task still open: a supervisor may hand it over
 }
+
+const OPEN_STATES: ReadonlySet<string> = new Set(["offered", "claimed", "running"]);
 
 function jobText(job: JobJson | null): string {
   if (!job) return "";
@@ -190,6 +194,8 @@ export function workRow(item: WorkItemJson): WorkRow {
     state: item.state,
     who: item.claimed_by || item.job?.cobot_name || "–",
     job: jobText(item.job),
+    id: item.id,
+    reassignable: item.kind === "operator" && OPEN_STATES.has(item.state),
   };
 }
 

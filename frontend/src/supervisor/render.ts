@@ -144,13 +144,25 @@ export function renderWorkRows(body: HTMLTableSectionElement, rows: readonly Wor
       element("td", {}, row.state),
       element("td", {}, row.who),
       element("td", {}, row.job),
+      element("td", {}, ...(row.reassignable ? [reassignButton(row)] : [])),
     ),
   );
   if (!lines.length) {
-    const none = element("td", { colspan: "4", class: "muted" }, "No open tasks.");
+    const none = element("td", { colspan: "5", class: "muted" }, "No open tasks.");
     lines.push(element("tr", { class: "none" }, none));
   }
   body.replaceChildren(...lines);
+}
+
+function reassignButton(row: WorkRow): HTMLButtonElement {
+  const attributes = {
+    type: "button",
+    "data-reassign": String(row.id),
+    "data-state": row.state,
+    "data-label": row.label,
+    "data-who": row.who,
+  };
+  return element("button", attributes, "Hand over…");
 }
 
 export function renderTimelineRow(row: TimelineRow): HTMLTableRowElement {

@@ -182,6 +182,11 @@ class WorkItemDetailSerializer(WorkItemSerializer):
         return dict(config.form) if config is not None and config.form is not None else None
 
 
+class PerformerSerializer(serializers.Serializer[Any]):
+    id = serializers.IntegerField(read_only=True)
+    username = serializers.CharField(read_only=True)
+
+
 class ReassignRequestSerializer(serializers.Serializer[dict[str, Any]]):
     user = serializers.IntegerField(
         allow_null=True,

@@ -36,6 +36,7 @@ from hrc.cases.api.serializers import (
     InterruptionSerializer,
     MessageRequestSerializer,
     MessageSerializer,
+    PerformerSerializer,
     QueuedJobSerializer,
     ReassignRequestSerializer,
     RefusalSerializer,
@@ -45,7 +46,7 @@ from hrc.cases.api.serializers import (
     WorkItemSerializer,
 )
 from hrc.cases.choices import CaseStatus, WorkItemKind
-from hrc.cases.errors import NotFound
+from hrc.cases.errors import Conflict, NotFound
 from hrc.cases.messages import receive_message
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.organisations.selectors import may_write_in
@@ -249,6 +250,17 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
         return Response(self._detail(item))
 
     @extend_schema(
+        responses={200: PerformerSerializer(many=True), **WRITE_REFUSALS},
+    )
+    @action(detail=True, methods=["get"])
+    def performers(self, request: Request, pk: str | None = None) -> Response:
+        """Who may do an operator task, by name: whom `reassign` takes. Engineers and admins."""
+        item = self._to_steer(request, pk)
+        if item.kind != WorkItemKind.OPERATOR:
+            raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+        return Response(PerformerSerializer(selectors.performers_of(item), many=True).data)
+
+    @extend_schema(
         request=ReassignRequestSerializer,
         responses={200: WorkItemDetailSerializer, **WRITE_REFUSALS},
     )
@@ -257,12 +269,8 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
         """Hands a task someone holds, or an offered one, to another operator who may do it; or
         gives a claimed one back to its candidates (`user`: null). Engineers and admins: for when
         the operator who holds it has gone. A started task stays started, with its new holder."""
-        item = selectors.work_items_visible_to(request.user).filter(pk=_item_id(pk)).first()
-        if item is None:
-            raise NotFound(f"There is no work item {pk} in your organisations.")
+        item = self._to_steer(request, pk)
         organisation = item.case.organisation_id
-        if not may_write_in(request.user, organisation):
-            raise PermissionDenied(WRITERS_ONLY)
         body = ReassignRequestSerializer(data=request.data)
         body.is_valid(raise_exception=True)
         wanted, to = body.validated_data["user"], None
@@ -273,6 +281,16 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
                 raise Rejected({"detail": f"There is no user {wanted} in this organisation."})
         item = services.reassign_work_item(item, by=_user(request), to=to)
         return Response(self._detail(item))
+
+    @staticmethod
+    def _to_steer(request: Request, pk: str | None) -> WorkItem:
+        """The work item, for an engineer or admin of its organisation (404 for an outsider)."""
+        item = selectors.work_items_visible_to(request.user).filter(pk=_item_id(pk)).first()
+        if item is None:
+            raise NotFound(f"There is no work item {pk} in your organisations.")
+        if not may_write_in(request.user, item.case.organisation_id):
+            raise PermissionDenied(WRITERS_ONLY)
+        return item
 
     @staticmethod
     def _detail(item: WorkItem) -> Any:

@@ -1,5 +1,6 @@
 """A supervisor reassigns an operator task: to another operator who may do it, or back to its
-candidates; the refusals; the wall (POST /api/work-items/{id}/reassign/)."""
+candidates; whom it may go to; the refusals; the wall (POST /api/work-items/{id}/reassign/,
+GET /api/work-items/{id}/performers/)."""
 
 from typing import Any
 
@@ -9,6 +10,7 @@ from rest_framework.test import APIClient
 
 from hrc.cases.choices import EventType
 from hrc.cases.models import Case, CaseEvent, WorkItem
+from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
@@ -161,3 +163,45 @@ def test_an_operator_may_not_reassign_and_an_outsider_learns_nothing(
     assert malformed.status_code == 404
     assert _client(operator).post("/api/work-items/x1/reassign/", {"user": None}, format="json").status_code == 404  # fmt: skip
     assert _state(item) == ("claimed", operator.username)
+
+
+def test_the_performers_are_the_candidates_and_the_teams_active_members_of_ours(
+    engineer_client: APIClient,
+    shared_case: Case,
+    choice_version: PatternVersion,
+    engineer: User,
+    operator: User,
+    colleague: User,
+    organisation: Organisation,
+    other_organisation: Organisation,
+) -> None:
+    item = factories.open_work_item(shared_case, "count")
+    answer = engineer_client.get(f"/api/work-items/{item.pk}/performers/")
+    assert answer.status_code == 200, answer.data
+    assert answer.data == [
+        {"id": colleague.pk, "username": "carl-colleague"},
+        {"id": operator.pk, "username": "olivia-operator"},
+    ]
+
+    team = organisation_services.create_team(organisation, name="Shift B")
+    gone = factories.make_member(organisation, Role.OPERATOR, "gus-gone")
+    organisation_services.set_team_members(team, [colleague.memberships.get(), gone.memberships.get()])  # fmt: skip
+    gone.is_active = False
+    gone.save()
+    factories.make_member(other_organisation, Role.OPERATOR, "their-operator")
+    by_team = factories.make_case(choice_version, started_by=engineer, actor_mapping={"o": {"team": "Shift B"}})  # fmt: skip
+    team_item = factories.open_work_item(by_team, "count")
+    answer = engineer_client.get(f"/api/work-items/{team_item.pk}/performers/")
+    assert [row["username"] for row in answer.data] == ["carl-colleague"]
+
+
+def test_only_engineers_and_admins_of_ours_see_the_performers(
+    shared_case: Case, operator: User, outsider: User, step_case: Case, engineer_client: APIClient
+) -> None:
+    item = factories.open_work_item(shared_case, "count")
+    url = f"/api/work-items/{item.pk}/performers/"
+    assert _client(operator).get(url).status_code == 403
+    assert _client(outsider).get(url).status_code == 404
+    step = factories.open_work_item(step_case, "tc1")
+    answer = engineer_client.get(f"/api/work-items/{step.pk}/performers/")
+    assert answer.status_code == 409
