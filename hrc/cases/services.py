@@ -203,6 +203,8 @@ def reassign_work_item(item: WorkItem, *, by: User, to: User | None) -> WorkItem
             )
             if not may.exists():
                 raise Invalid(f"{to.get_username()} may not do {item.label}: not among its candidates or in its team.")  # fmt: skip
+            if not to.is_active:
+                raise Invalid(f"{to.get_username()} cannot sign in any more: choose someone who can.")  # fmt: skip
             if holder is not None and holder.pk == to.pk:
                 raise Conflict(f"{to.get_username()} holds {item.label} already.")
             if item.state == WorkItemState.OFFERED:

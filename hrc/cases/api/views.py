@@ -3,8 +3,8 @@
 Every queryset starts from hrc.cases.selectors, which see only the user's
 organisations: an outsider gets 404 and empty lists, also on POST actions.
 Roles are checked per object after that: engineers and admins start, cancel,
-suspend and resume cases, resolve incidents, send messages and set actor
-mappings; operators get 403. Work items are the services' to allow
+suspend and resume cases, resolve incidents, send messages, set actor
+mappings and reassign work items; operators get 403. Work items are the services' to allow
 (services._locked_item, by selectors.performable_by). The services' refusals (hrc.cases.errors) reach the
 client as 400, 403 or 409 with a `detail` (hrc.api.exceptions).
 """

@@ -112,6 +112,8 @@ def test_what_a_reassignment_refuses_says_why_and_changes_nothing(
 ) -> None:
     item = factories.open_work_item(shared_case, "count")
     stranger = factories.make_member(organisation, Role.OPERATOR, "sam-stranger")  # no candidate
+    colleague.is_active = False
+    colleague.save()
     offered = {
         None: (409, "Nobody holds count parts: name who should do it."),
         stranger.pk: (
@@ -119,6 +121,7 @@ def test_what_a_reassignment_refuses_says_why_and_changes_nothing(
             "sam-stranger may not do count parts: not among its candidates or in its team.",
         ),
         outsider.pk: (400, f"There is no user {outsider.pk} in this organisation."),
+        colleague.pk: (400, "carl-colleague cannot sign in any more: choose someone who can."),
         10**9: (400, f"There is no user {10**9} in this organisation."),
     }
     for target, expected in offered.items():
