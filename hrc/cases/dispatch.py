@@ -34,6 +34,16 @@ def send_on_commit(task_name: str, *args: Any, countdown: float = 0) -> None:
     transaction.on_commit(lambda: _send(task_name, args, countdown))
 
 
+def send_on_commit_if(wanted: Callable[[], bool], task_name: str, *args: Any) -> None:
+    """send_on_commit, when `wanted()`, asked once the transaction has committed, says so."""
+
+    def send() -> None:
+        if wanted():
+            _send(task_name, args, 0)
+
+    transaction.on_commit(send)
+
+
 def _send(task_name: str, args: tuple[Any, ...], countdown: float) -> None:
     from hrc.cases import tasks  # the tasks module imports the services that import this one
 

@@ -297,7 +297,20 @@ def finish_job(lease: Lease, result: dict[str, Any]) -> None:
         if case.status in (CaseStatus.RUNNING, CaseStatus.SUSPENDED):
             services.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
-        dispatch.send_on_commit("run_job", job.pk)
+        _ring_for_next_on_commit(job)
+
+
+def _ring_for_next_on_commit(job: Job) -> None:
+    """Rings the cobot's doorbell for its next job once this transaction has committed, if a
+    job is queued for it then: most often none is, and a doorbell would cost a task and a
+    transaction to find nothing. Asked after the commit, so none is missed: a job queued while
+    this one ran rang its own doorbell, which found the cobot busy, after it had committed."""
+    cobot_id = job.cobot_id
+
+    def queued() -> bool:
+        return Job.objects.filter(cobot_id=cobot_id, state=JobState.QUEUED).exists()
+
+    dispatch.send_on_commit_if(queued, "run_job", job.pk)
 
 
 def fail_job(lease: Lease, error: DriverError) -> None:
@@ -330,7 +343,7 @@ def fail_job(lease: Lease, error: DriverError) -> None:
                 else IncidentKind.STEP_FAILED
             )
             services.open_incident(case, kind, str(error), item=item, cobot_state=error.state)
-            dispatch.send_on_commit("run_job", job.pk)  # the cobot's next job may go
+            _ring_for_next_on_commit(job)  # the cobot's next job may go
         case.save()
 
 

@@ -109,3 +109,32 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     assert results["first"] is not None
     assert results["second"] is None  # the cobot is busy with the first job
     assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_finished_job_rings_for_the_cobots_next_job_only_when_one_is_queued(
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
+) -> None:
+    import redis
+
+    from hrc.celery import app
+
+    version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
+    cobot = factories.make_cobot(organisation, name="shared")
+    mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
+    for _ in range(2):
+        factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    doorbells = redis.Redis.from_url(broker.url)
+    queue = app.conf.task_default_queue
+    assert doorbells.llen(queue) == 2  # each job's own, rung as its case started
+
+    first = jobs.lease_next_job(cobot.pk)
+    assert first is not None
+    jobs.finish_job(first, {"outcome": "ran", "seconds": 0})
+    assert doorbells.llen(queue) == 3  # the second job waits: ring for it
+
+    second = jobs.lease_next_job(cobot.pk)
+    assert second is not None
+    jobs.finish_job(second, {"outcome": "ran", "seconds": 0})
+    assert doorbells.llen(queue) == 3  # nothing left to run on the cobot: no doorbell
+    assert set(Job.objects.filter(cobot=cobot).values_list("state", flat=True)) == {JobState.SUCCEEDED}  # fmt: skip
