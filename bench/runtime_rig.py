@@ -48,8 +48,9 @@ SETTINGS_MODULE = "hrc.settings.test"  # dev's DEBUG would keep every query in m
 DEFAULT_DATABASE_SERVER = "postgres://postgres@127.0.0.1:5432"
 PROGRAM, STEP = "Coexistence_PickAndPlace", 3  # step 3, "pick": a 2 s wait, zero at time scale 0
 FLOOR_REGISTER, FLOOR_VALUES_FROM = "Int29", 1_000_000  # an input no handshake writes
-# An operator is never as quick as the bench: give the worker the moment it
-# needs to answer the doorbell its own finish rang before the next step starts.
+# An operator is never as quick as the bench: give the worker and the server the
+# moment they need to finish with the last case (its broadcasts, its connection
+# back to the pool) before the next step is timed.
 SETTLE_SECONDS = 0.01
 
 # The Celery floor: a bare app configured as hrc's (acks late, prefetch 1; its
