@@ -58,7 +58,13 @@ SETTLE_SECONDS = 0.01
 # wall-clock time its first line ran at. Its worker imports this module, which
 # is why nothing at module level imports Django or hrc.
 FLOOR_BROKER_ENV, FLOOR_QUEUE = "HRC_BENCH_FLOOR_BROKER", "bench-floor"
-floor_app = Celery("hrc-bench-floor", broker=os.environ.get(FLOOR_BROKER_ENV, "memory://"))
+# Not the current app: hrc's shared tasks go through the current one, and a process that
+# imports this module (the tests collect it) would send hrc's doorbells nowhere.
+floor_app = Celery(
+    "hrc-bench-floor",
+    broker=os.environ.get(FLOOR_BROKER_ENV, "memory://"),
+    set_as_current=False,
+)
 floor_app.conf.update(
     task_acks_late=True, worker_prefetch_multiplier=1, task_default_queue=FLOOR_QUEUE
 )

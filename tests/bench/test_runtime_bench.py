@@ -33,6 +33,18 @@ def test_the_bench_patterns_are_publishable(document: dict[str, Any]) -> None:
     assert report.sound is True
 
 
+def test_the_floor_app_leaves_hrcs_tasks_on_hrcs_app() -> None:
+    # This module imported the rig, and with it the floor's Celery app: hrc's shared tasks
+    # must still go through hrc's app and its broker, not the floor's (memory://).
+    from celery import current_app
+
+    from hrc.cases import tasks
+    from hrc.celery import app
+
+    assert current_app.main == app.main == "hrc"
+    assert tasks.run_job.app is app
+
+
 def test_quick_sets_the_small_sizes_and_explicit_options_win() -> None:
     settings = parse_args(["--quick", "--steps", "7", "--workers", "2,1"])
 

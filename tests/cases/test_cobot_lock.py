@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import threading
 import time
-from concurrent.futures import Executor, Future
 from typing import Any
 
 import pytest
 from django.contrib.auth.models import User
 from django.db import connection, connections, transaction
 
-from hrc.cases import dispatch, jobs
+from hrc.cases import jobs
 from hrc.cases.choices import JobState
 from hrc.cases.launcher import RedisProcess
 from hrc.cases.models import Job
@@ -112,41 +111,30 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
 
 
-class _Doorbells(Executor):
-    """Where `dispatch.run_inline` sends the doorbells (the seam run_pattern and the embedded
-    demo use instead of Celery): kept, not run, so a test counts them. A broker would not
-    do here: what reaches its queue is what no worker took, not what was sent."""
-
-    def __init__(self) -> None:
-        self.rung: list[Any] = []
-
-    def submit(self, fn: Any, /, *args: Any, **kwargs: Any) -> Future[Any]:
-        self.rung.append(fn)
-        done: Future[Any] = Future()
-        done.set_result(None)
-        return done
-
-
 @pytest.mark.django_db(transaction=True)
 def test_a_finished_job_rings_for_the_cobots_next_job_only_when_one_is_queued(
-    organisation: Organisation, engineer: User, operator: User
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
 ) -> None:
+    import redis
+
+    from hrc.celery import app
+
     version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
     cobot = factories.make_cobot(organisation, name="shared")
     mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
-    doorbells = _Doorbells()
-    with dispatch.run_inline(doorbells):
-        for _ in range(2):
-            factories.make_case(version, started_by=engineer, actor_mapping=mapping)
-        assert len(doorbells.rung) == 2  # each job's own, rung as its case started
+    for _ in range(2):
+        factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    doorbells = redis.Redis.from_url(broker.url)
+    queue = app.conf.task_default_queue
+    assert doorbells.llen(queue) == 2  # each job's own, rung as its case started
 
-        first = jobs.lease_next_job(cobot.pk)
-        assert first is not None
-        jobs.finish_job(first, {"outcome": "ran", "seconds": 0})
-        assert len(doorbells.rung) == 3  # the second job waits: ring for it
+    first = jobs.lease_next_job(cobot.pk)
+    assert first is not None
+    jobs.finish_job(first, {"outcome": "ran", "seconds": 0})
+    assert doorbells.llen(queue) == 3  # the second job waits: ring for it
 
-        second = jobs.lease_next_job(cobot.pk)
-        assert second is not None
-        jobs.finish_job(second, {"outcome": "ran", "seconds": 0})
-        assert len(doorbells.rung) == 3  # nothing left to run on the cobot: no doorbell
+    second = jobs.lease_next_job(cobot.pk)
+    assert second is not None
+    jobs.finish_job(second, {"outcome": "ran", "seconds": 0})
+    assert doorbells.llen(queue) == 3  # nothing left to run on the cobot: no doorbell
     assert set(Job.objects.filter(cobot=cobot).values_list("state", flat=True)) == {JobState.SUCCEEDED}  # fmt: skip
