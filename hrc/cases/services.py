@@ -177,17 +177,17 @@ def reassign_work_item(item: WorkItem, *, by: User, to: User | None) -> WorkItem
     what a supervisor does when the operator who holds it has gone. A started task stays
     started, with its new holder, who completes it. The API lets engineers and admins only.
 
-    Invalid when `to` may not perform it (not a candidate, not in its team, not a member);
+    Invalid when `to` may not perform it (not a candidate, not in its team, not an active member);
     Conflict when it has ended, or a started task would be left with nobody to finish it.
     """
-    from hrc.cases.selectors import performable_by
+    from hrc.cases.selectors import performers_of
 
     with transaction.atomic():
         case = lock_case(item.case_id)
         item = WorkItem.objects.select_related("claimed_by").get(pk=item.pk)
+        item.case = case  # what performers_of and the API's answer read
         _check_open(case)
-        if item.kind != WorkItemKind.OPERATOR:
-            raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+        check_operator_task(item)
         if item.state not in OPEN_WORK_ITEM_STATES:
             raise Conflict(_moved_on(item, "reassigned"))
         holder = item.claimed_by
@@ -198,13 +198,11 @@ def reassign_work_item(item: WorkItem, *, by: User, to: User | None) -> WorkItem
                 raise Conflict(f"{item.label} has started: name who finishes it.")
             item.state, item.claimed_by = WorkItemState.OFFERED, None
         else:
-            may = WorkItem.objects.filter(
-                performable_by(to), pk=item.pk, case__organisation__memberships__user_id=to.pk
-            )
-            if not may.exists():
-                raise Invalid(f"{to.get_username()} may not do {item.label}: not among its candidates or in its team.")  # fmt: skip
+            # The same rule as the list the supervisor chose from.
             if not to.is_active:
                 raise Invalid(f"{to.get_username()} cannot sign in any more: choose someone who can.")  # fmt: skip
+            if not performers_of(item).filter(pk=to.pk).exists():
+                raise Invalid(f"{to.get_username()} may not do {item.label}: not among its candidates or in its team.")  # fmt: skip
             if holder is not None and holder.pk == to.pk:
                 raise Conflict(f"{to.get_username()} holds {item.label} already.")
             if item.state == WorkItemState.OFFERED:
@@ -217,7 +215,6 @@ def reassign_work_item(item: WorkItem, *, by: User, to: User | None) -> WorkItem
                     "to": to.get_username() if to else None},
         )  # fmt: skip
         case.save()
-    item.case = case  # what the API's answer reads
     return item
 
 
@@ -734,8 +731,7 @@ def _locked_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
         performable_by(user), pk=OuterRef("pk"), case__organisation__memberships__user_id=user.pk
     )  # a candidate (or in the item's team) and still a member; read with the item in one query
     item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item_id)
-    if item.kind != WorkItemKind.OPERATOR:
-        raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+    check_operator_task(item)
     if not item.performable:
         raise NotAllowed(f"{item.label} is not offered to you.")
     # What the caller hands back (the API's answer) reads these; they are in hand.
@@ -743,6 +739,12 @@ def _locked_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
     if item.claimed_by_id == user.pk:
         item.claimed_by = user
     return case, item
+
+
+def check_operator_task(item: WorkItem) -> None:
+    """Conflict unless the work item is an operator's (a cobot's is the workers' to drive)."""
+    if item.kind != WorkItemKind.OPERATOR:
+        raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
 
 
 def _check_open(case: Case) -> None:

@@ -46,7 +46,7 @@ from hrc.cases.api.serializers import (
     WorkItemSerializer,
 )
 from hrc.cases.choices import CaseStatus, WorkItemKind
-from hrc.cases.errors import Conflict, NotFound
+from hrc.cases.errors import NotFound
 from hrc.cases.messages import receive_message
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.organisations.selectors import may_write_in
@@ -256,8 +256,7 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
     def performers(self, request: Request, pk: str | None = None) -> Response:
         """Who may do an operator task, by name: whom `reassign` takes. Engineers and admins."""
         item = self._to_steer(request, pk)
-        if item.kind != WorkItemKind.OPERATOR:
-            raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+        services.check_operator_task(item)
         return Response(PerformerSerializer(selectors.performers_of(item), many=True).data)
 
     @extend_schema(
