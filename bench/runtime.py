@@ -346,7 +346,7 @@ def _celery_rate(bench: Rig, count: int) -> tuple[float, float]:
         for _ in range(count):
             note_start.apply_async((key,))
         roles = [*worker.pids(), *([bench.redis.process.pid] if bench.redis.process else [])]
-        meter = CpuMeter(lambda: {"celery": {pid: _cpu_of(pid) for pid in roles}}).start()
+        meter = _processes_meter("celery", roles)
         _control(floor_app.control.add_consumer, FLOOR_QUEUE, [worker.node])
         deadline = time.monotonic() + 600
         while client.llen(key) < count:
@@ -377,7 +377,7 @@ def _step_rate(bench: Rig, count: int) -> tuple[float, float]:
     try:
         steps = [StepCommand(step=STEP, fence=Fence(FLOOR_VALUES_FROM + n)) for n in range(count)]
         driver.run_step(steps[0])  # the session and its subscription
-        meter = CpuMeter(lambda: {"step": {pid: _cpu_of(pid) for pid in roles}}).start()
+        meter = _processes_meter("step", roles)
         started = time.perf_counter()
         for step in steps[1:]:
             result = driver.run_step(step)
@@ -387,6 +387,11 @@ def _step_rate(bench: Rig, count: int) -> tuple[float, float]:
         return rate, _ms_each(meter.stop(), "step", count - 1)
     finally:
         driver.close()
+
+
+def _processes_meter(role: str, pids: Sequence[int]) -> CpuMeter:
+    """A started CpuMeter of one role: these processes."""
+    return CpuMeter(lambda: {role: {pid: _cpu_of(pid) for pid in pids}}).start()
 
 
 def _ms_each(cpu: Mapping[str, float] | None, role: str, count: int) -> float:

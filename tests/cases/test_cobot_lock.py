@@ -15,6 +15,7 @@ import time
 from typing import Any
 
 import pytest
+import redis
 from django.contrib.auth.models import User
 from django.db import connection, connections, transaction
 
@@ -22,6 +23,8 @@ from hrc.cases import jobs
 from hrc.cases.choices import JobState
 from hrc.cases.launcher import RedisProcess
 from hrc.cases.models import Job
+from hrc.celery import app
+from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 from tests import factories
 
@@ -53,6 +56,16 @@ def _one_cobot_task() -> dict[str, Any]:
     }
 
 
+def _two_jobs_queued_on_one_cobot(organisation: Organisation, engineer: User, operator: User) -> Cobot:  # fmt: skip
+    """Two cases of _one_cobot_task on the same cobot: both jobs queued as the cases start."""
+    version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
+    cobot = factories.make_cobot(organisation, name="shared")
+    mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
+    for _ in range(2):
+        factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    return cobot
+
+
 def _waiting_for_a_lock() -> bool:
     with connection.cursor() as cursor:
         cursor.execute(
@@ -67,11 +80,7 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
 ) -> None:
     # `broker`: the cases' doorbells go to a private redis-server that no worker reads.
-    version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
-    cobot = factories.make_cobot(organisation, name="shared")
-    mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
-    for _ in range(2):
-        factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    cobot = _two_jobs_queued_on_one_cobot(organisation, engineer, operator)
     assert Job.objects.filter(cobot=cobot, state=JobState.QUEUED).count() == 2
 
     leased = threading.Event()
@@ -115,15 +124,7 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
 def test_a_finished_job_rings_for_the_cobots_next_job_only_when_one_is_queued(
     broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
 ) -> None:
-    import redis
-
-    from hrc.celery import app
-
-    version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
-    cobot = factories.make_cobot(organisation, name="shared")
-    mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
-    for _ in range(2):
-        factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    cobot = _two_jobs_queued_on_one_cobot(organisation, engineer, operator)
     doorbells = redis.Redis.from_url(broker.url)
     queue = app.conf.task_default_queue
     assert doorbells.llen(queue) == 2  # each job's own, rung as its case started
