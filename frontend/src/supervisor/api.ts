@@ -76,6 +76,11 @@ export class Refusal extends Error {
   }
 }
 
+/** What to show for a failed request: the server's refusal, or the error itself. */
+export function problemOf(error: unknown): string {
+  return error instanceof Refusal ? error.message : String(error);
+}
+
 /** What the API says went wrong: its `detail` (every refusal has one), else the status. */
 export function refusalMessage(status: number, body: unknown): string {
   if (body && typeof body === "object" && "detail" in body) {

@@ -12,9 +12,9 @@ import type { LiveEvent } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { LiveStore } from "../live/store";
 import {
-  Refusal,
   getJson,
   postJson,
+  problemOf,
   type CaseJson,
   type EventJson,
   type IncidentJson,
@@ -102,7 +102,7 @@ class Refresher {
     }
     this.running = this.refresh()
       .then(() => this.show(""))
-      .catch((error: unknown) => this.show(error instanceof Refusal ? error.message : String(error)))
+      .catch((error: unknown) => this.show(problemOf(error)))
       .finally(() => {
         this.running = null;
         if (this.again) {
@@ -178,7 +178,7 @@ async function resolve(
     applyIncident(card, incident);
     return incident;
   } catch (error) {
-    if (errors) errors.textContent = error instanceof Refusal ? error.message : String(error);
+    if (errors) errors.textContent = problemOf(error);
     return null;
   } finally {
     buttons.forEach((button) => (button.disabled = false));
@@ -232,7 +232,7 @@ function onReassign(workItemsUrl: string, after: () => Promise<void>): void {
       })
       .catch((error: unknown) => {
         select.replaceChildren();
-        errors.textContent = error instanceof Refusal ? error.message : String(error);
+        errors.textContent = problemOf(error);
       })
       .finally(() => {
         button.disabled = false;
@@ -252,7 +252,7 @@ function onReassign(workItemsUrl: string, after: () => Promise<void>): void {
         void after();
       })
       .catch((error: unknown) => {
-        errors.textContent = error instanceof Refusal ? error.message : String(error);
+        errors.textContent = problemOf(error);
       })
       .finally(() => (handOver.disabled = false));
   });
