@@ -13,7 +13,9 @@ import dj_database_url
 from hrc.settings.env import env_bool, env_list, env_str, env_url
 
 BASE_DIR = Path(__file__).resolve().parent.parent.parent
-VAR_DIR = BASE_DIR / "var"
+# Where the embedded defaults keep their files (the SQLite database, the demo's logs, the
+# simulated cobots' state); tests that run the embedded default point it elsewhere.
+VAR_DIR = Path(env_str("HRC_VAR_DIR") or BASE_DIR / "var")
 
 SECRET_KEY = env_str("SECRET_KEY", "dev-only-not-secret") or ""
 DEBUG = env_bool("DEBUG", False)
@@ -89,6 +91,20 @@ else:
     DATABASES = {
         "default": {"ENGINE": "django.db.backends.sqlite3", "NAME": str(VAR_DIR / "hrc.sqlite3")}
     }
+if DATABASES["default"]["ENGINE"] == "django.db.backends.sqlite3":
+    # SQLite has one writer at a time and no row locks (select_for_update is a no-op).
+    # IMMEDIATE takes the write lock when a transaction begins, so every transaction that
+    # would lock rows on PostgreSQL runs alone, and none fails half-way when a second
+    # writer upgrades its read lock (the "database is locked" of a DEFERRED begin). WAL lets
+    # readers (pages, the tablets' snapshots) go on beside the writer; a writer that finds
+    # the lock taken waits up to `timeout` seconds for it instead of failing at once.
+    DATABASES["default"].setdefault("OPTIONS", {}).update(
+        {
+            "transaction_mode": "IMMEDIATE",
+            "timeout": 30,
+            "init_command": "PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL;",
+        }
+    )
 DEFAULT_AUTO_FIELD = "django.db.models.BigAutoField"
 
 REDIS_URL = env_url("REDIS_URL", {"redis", "rediss"})
