@@ -236,8 +236,7 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     """
 
     def ready(state: dict[str, Any]) -> bool:
-        loaded = urua.program_base_name(str(state.get("CurrentProgram") or ""))
-        return loaded == program and state.get("ProgramState") == urua.PROGRAM_PLAYING
+        return _loaded(state) == program and state.get("ProgramState") == urua.PROGRAM_PLAYING
 
     # The subscription's view saves a round trip per step; the step's own
     # handshake reads afresh if the cobot is not ready after all.
@@ -260,9 +259,19 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
             f"{driver.name}'s cell was stopped from a tablet; resume it there, then retry.",
             state=state,
         )
-    if urua.program_base_name(loaded) != program:
+    if _loaded(state) != program:
+        # Another pattern's program, idle between steps (no job of this cobot runs but
+        # ours): a program is loaded only once it has stopped.
+        if loaded and state.get("ProgramState") != urua.PROGRAM_STOPPED:
+            driver.call("StopProgram", timeout=timeout)
         driver.call("SelectProgram", program, timeout=timeout)
     driver.call("StartProgram", timeout=timeout)
+
+
+def _loaded(state: dict[str, Any]) -> str:
+    """The base name of the program the cobot has loaded; "" when none is."""
+    loaded = str(state.get("CurrentProgram") or "").strip()
+    return urua.program_base_name(loaded) if loaded else ""
 
 
 def _call_device(driver: SyncDriver, lease: Lease) -> dict[str, Any]:
