@@ -61,7 +61,10 @@ class CaseNet:
         self.pattern = pattern
         self.net = build_execution_net(pattern)
         self._transitions = {t.id: t for t in self.net.transitions}
-        self._needs = {place: c.needed() for place, c in constraint_places(pattern).items()}
+        places = constraint_places(pattern)
+        self._needs = {place: c.needed() for place, c in places.items()}
+        # func-done places: the supported task (its completion fills it) per place.
+        self._supported = {p: c.first for p, c in places.items() if c.kind == "func-done"}
         self._initial_data = initial_data(pattern)
         self.tasks: dict[str, TaskConfig] = {}
         self.performers: dict[str, str] = {}
@@ -191,6 +194,16 @@ class CaseNet:
 
     def complete(self, marking: Marking, task: str) -> Marking:
         return self._fire(marking, f"complete:{task}", f"{task} cannot complete")
+
+    def holding_for(self, task: str, marking: Marking | None = None) -> list[str]:
+        """The supported tasks whose completion `task`'s completion waits for (func constraints),
+        in constraint order: those still missing in `marking`, or all of them without one.
+        [] when no func constraint holds `task` back."""
+        return [
+            self._supported[place]
+            for place, weight in self._transitions[f"complete:{task}"].pre
+            if place in self._supported and (marking is None or marking.get(place) < weight)
+        ]
 
     def why_not(self, marking: Marking, transition: str) -> str:
         """What a transition waits for, as a person says it; "" when it is enabled."""

@@ -193,6 +193,22 @@ def test_a_func_supporter_cannot_complete_before_the_supported_task_has() -> Non
     assert net.can_complete(marking, "tc2")
 
 
+def test_a_held_supporter_names_the_supported_tasks_it_still_waits_for() -> None:
+    # tc2 supports to1 and to2: it holds until both have completed.
+    net = CaseNet(read_pattern(two_lanes([("to1", "tc2", "func"), ("to2", "tc2", "func")])))
+    marking, _ = net.settle(net.initial, {})
+    marking = net.start(net.complete(net.start(marking, "tc1"), "tc1"), "tc2")
+    marking = net.start(marking, "to1")
+
+    assert net.holding_for("tc2", marking) == ["to1", "to2"]
+    marking = net.complete(marking, "to1")
+    assert net.holding_for("tc2", marking) == ["to2"]
+    marking = net.complete(net.start(marking, "to2"), "to2")
+    assert net.holding_for("tc2", marking) == []
+    assert net.holding_for("tc2") == ["to1", "to2"]  # without a marking: every supported task
+    assert net.holding_for("tc1") == []  # no func constraint on tc1
+
+
 # Deferred choice ---------------------------------------------------------------------
 
 
