@@ -4,8 +4,11 @@ One cobot runs one job at a time. `run_next_job` takes the cobot's row lock,
 and only when no job of that cobot is running does it lease the first
 queued job that may start (first come, first served; a job whose case is
 suspended, whose task waits for a constraint, or whose cobot is paused for
-an operator in a shared area waits and says why). The lease is the lock: a
-worker that lost it (killed, too slow) may change nothing afterwards.
+an operator in a shared area waits and says why). A cobot whose task another
+case's func constraint holds (its step done, the supported task not yet) is
+that case's until the hold ends: other cases' jobs wait ("holding for: …").
+The lease is the lock: a worker that lost it (killed, too slow) may change
+nothing afterwards.
 
 Exactly once: a step carries the fencing token (job id, attempt) and the
 driver checks the cobot's registers before sending, so automatic retries and
@@ -26,7 +29,7 @@ from typing import Any
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import Exists, Q, QuerySet
+from django.db.models import Exists, OuterRef, Q, QuerySet
 from django.utils import timezone
 
 from hrc.cases import dispatch, services
@@ -40,6 +43,7 @@ from hrc.cases.choices import (
 )
 from hrc.cases.models import Case, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
+from hrc.cases.selectors import holding_work_items, why_held
 from hrc.cobots import urua
 from hrc.cobots.drivers.base import (
     CobotNotReady,
@@ -126,6 +130,8 @@ def _lease_next(which: Q) -> Lease | None:
             return None
         # The queue, with the reasons the whole cobot waits (a job running, a pause for an
         # operator in a shared area) on each row: a second statement, so they are fresh.
+        # `held`: another case's func hold reserves the cobot; the holding case's own jobs
+        # may go (its pattern may give the cobot the supported task itself).
         queued = (
             Job.objects.filter(
                 cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
@@ -134,25 +140,36 @@ def _lease_next(which: Q) -> Lease | None:
             .annotate(
                 busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
                 paused=Exists(_unsettled_interruptions(cobot)),
+                held=Exists(_held_by_another_case(cobot.pk)),
             )
-            .values_list("pk", "case_id", "busy", "paused")[: settings.HRC_QUEUE_LOOKAHEAD]
+            .values_list("pk", "case_id", "busy", "paused", "held")[: settings.HRC_QUEUE_LOOKAHEAD]
         )  # fmt: skip
-        for job_id, case_id, busy, paused in list(queued):
+        for job_id, case_id, busy, paused, held in list(queued):
             if busy or paused:
                 return None
-            lease = _lease_if_ready(cobot, job_id, case_id, now)
+            lease = _lease_if_ready(cobot, job_id, case_id, now, held=held)
             if lease is not None:
                 return lease
     return None
 
 
-def _lease_if_ready(cobot: Cobot, job_id: int, case_id: int, now: dt.datetime) -> Lease | None:
+def _held_by_another_case(cobot_id: int | OuterRef) -> QuerySet[WorkItem]:
+    """The cobot's holding work items of cases other than the outer job's (OuterRef case_id)."""
+    return holding_work_items().filter(cobot_id=cobot_id).exclude(case_id=OuterRef("case_id"))
+
+
+def _lease_if_ready(
+    cobot: Cobot, job_id: int, case_id: int, now: dt.datetime, *, held: bool
+) -> Lease | None:
+    """Leases the job when it may start now, else records why it waits; `held` is the queue
+    statement's word that another case's func hold reserved the cobot (asked again here)."""
     case, job = _lock_case_and_job(case_id, job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
     net = case_net(case.version)
-    waiting = _why_waiting(case, net, item)
+    waiting = _why_held(cobot, case) if held else ""
+    waiting = waiting or _why_waiting(case, net, item)
     if not waiting and item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
     if waiting:
@@ -185,6 +202,15 @@ def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
         .get(pk=job_id)
     )
     return case, job
+
+
+def _why_held(cobot: Cobot, case: Case) -> str:
+    """Why another case's func hold keeps the cobot from `case`; "" when the hold has ended
+    since the queue was read (it ends in a transaction of its own, then rings the doorbell)."""
+    holding = (
+        holding_work_items().filter(cobot=cobot).exclude(case=case).select_related("case__version")
+    ).first()
+    return why_held(holding) if holding is not None else ""
 
 
 def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
@@ -310,16 +336,9 @@ def finish_job(lease: Lease, result: dict[str, Any]) -> None:
 
 
 def _ring_for_next_on_commit(job: Job) -> None:
-    """Rings the cobot's doorbell for its next job once this transaction has committed, if a
-    job is queued for it then: most often none is, and a doorbell would cost a task and a
-    transaction to find nothing. Asked after the commit, so none is missed: a job queued while
-    this one ran rang its own doorbell, which found the cobot busy, after it had committed."""
-    cobot_id = job.cobot_id
-
-    def queued() -> bool:
-        return Job.objects.filter(cobot_id=cobot_id, state=JobState.QUEUED).exists()
-
-    dispatch.send_on_commit_if(queued, "run_job", job.pk)
+    """Rings the cobot's doorbell for its next job once this transaction has committed, if one
+    is queued then (services.ring_for_next_job_on_commit)."""
+    services.ring_for_next_job_on_commit(job.pk, job.cobot_id)
 
 
 def fail_job(lease: Lease, error: DriverError) -> None:
@@ -410,12 +429,17 @@ def _interruptions_to_redo() -> list[tuple[str, int]]:
 
 
 def _first_due_per_cobot(now: dt.datetime) -> list[int]:
-    """The first due job of each cobot that has nothing running."""
+    """The first due job of each cobot that has nothing running, leaving out the jobs another
+    case's func hold keeps waiting (the holding case's own may go)."""
     busy = set(Job.objects.filter(state=JobState.RUNNING).values_list("cobot_id", flat=True))
     firsts: dict[int, int] = {}
-    due = Job.objects.filter(
-        state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
-    ).exclude(cobot_id__in=busy)
+    due = (
+        Job.objects.filter(
+            state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
+        )
+        .exclude(cobot_id__in=busy)
+        .exclude(Exists(_held_by_another_case(OuterRef("cobot_id"))))
+    )
     for job_id, cobot_id in due.order_by("queued_at", "id").values_list("pk", "cobot_id"):
         firsts.setdefault(cobot_id, job_id)
     return list(firsts.values())

@@ -24,6 +24,8 @@ from django.db.models.functions import Coalesce
 
 from hrc.cases.choices import OPEN_WORK_ITEM_STATES, JobState, WorkItemKind, WorkItemState
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
+from hrc.cases.nets import case_net
+from hrc.engine.petri import Marking
 from hrc.organisations.models import Team
 from hrc.organisations.selectors import AnyUser, organisations_of, writable_organisations
 
@@ -165,6 +167,49 @@ def _queued_ahead(prefix: str) -> Coalesce:
         .values("n")
     )
     return Coalesce(Subquery(ahead), Value(0))
+
+
+# Cobots in use: a step running, or a func hold -------------------------------------------
+
+
+def holding_work_items() -> QuerySet[WorkItem]:
+    """Cobot work items that hold their cobot: the step has run (its job succeeded) but a func
+    constraint holds the task until the task it supports completes. The cobot may hold the part
+    meanwhile, so no other case may move it (jobs.py). An item whose completion opened an
+    incident (its outputs did not map) is not held, but waits for a person: it holds nothing."""
+    undecided = Incident.objects.filter(work_item=OuterRef("pk"), resolved_at__isnull=True)
+    return WorkItem.objects.filter(
+        state=WorkItemState.RUNNING, job__state=JobState.SUCCEEDED
+    ).exclude(Exists(undecided))
+
+
+def why_held(item: WorkItem) -> str:
+    """'holding for: <supported task>, case N' for a holding work item (its case read along)."""
+    case = item.case
+    net = case_net(case.version)
+    tasks = net.holding_for(item.task, Marking(case.marking)) or net.holding_for(item.task)
+    labels = " and ".join(net.labels[task] for task in tasks) or item.label
+    return f"holding for: {labels}, case {case.pk}"
+
+
+def cobot_in_use(cobot_id: int) -> str:
+    """Why a case is using the cobot now, as a sentence; "" when none is.
+
+    A step (or device call) running: "step N of <task>, case M is running". A
+    func hold: "holding for: <supported task>, case M". Reads across organisations:
+    the caller has checked the user may see the cobot.
+    """
+    running = (
+        Job.objects.filter(cobot_id=cobot_id, state=JobState.RUNNING)
+        .select_related("work_item")
+        .first()
+    )
+    if running is not None:
+        label, number = running.work_item.label, (running.command or {}).get("number")
+        what = f"step {number} of {label}" if running.kind == WorkItemKind.STEP else label
+        return f"{what}, case {running.case_id} is running"
+    held = holding_work_items().filter(cobot_id=cobot_id).select_related("case__version").first()
+    return why_held(held) if held is not None else ""
 
 
 def incidents_visible_to(user: AnyUser, *, open_only: bool = True) -> QuerySet[Incident]:

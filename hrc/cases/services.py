@@ -467,6 +467,8 @@ def _complete_held_steps(case: Case, net: CaseNet) -> bool:
     for item in held:
         if net.can_complete(Marking(case.marking), item.task):
             done = _complete_step(case, net, item, item.job.result or {}) or done
+            # Completed, or an incident that its outputs did not map: it holds the cobot no more.
+            _end_hold(item.job)
     return done
 
 
@@ -559,6 +561,10 @@ def _whole(task: str, what: str, value: Any) -> int:
 
 
 def _withdraw(case: Case, item: WorkItem, why: str) -> None:
+    if item.state == WorkItemState.RUNNING and item.kind != WorkItemKind.OPERATOR:
+        held = Job.objects.filter(work_item=item, state=JobState.SUCCEEDED).first()
+        if held is not None:  # the case ends while its func constraint holds the cobot
+            _end_hold(held)
     item.state, item.ended_at = WorkItemState.WITHDRAWN, timezone.now()
     item.save(update_fields=["state", "ended_at"])
     Job.objects.filter(work_item=item, state__in=[JobState.QUEUED, JobState.FAILED]).update(
@@ -673,6 +679,25 @@ def _end_interruptions(case: Case, which: Q) -> None:
         record_event(case, EventType.TASK_RESUMED, item=interruption.work_item,
                 detail={"interruption": interruption.pk, "seconds": round(seconds, 3)})  # fmt: skip
         dispatch.send_on_commit("resume_cobot", interruption.pk)
+
+
+def _end_hold(job: Job) -> None:
+    """The cobot a func hold reserved for this case is free once this transaction commits: its
+    next job goes now, not at the next sweep. Held items end only by completing (advance's
+    held completions, which a skip or a message reaches too) or by withdrawal (the case ends)."""
+    ring_for_next_job_on_commit(job.pk, job.cobot_id)
+
+
+def ring_for_next_job_on_commit(job_id: int, cobot_id: int) -> None:
+    """Rings the doorbell of `job_id`'s cobot once this transaction has committed, if a job is
+    queued for the cobot then: most often none is, and a doorbell would cost a task and a
+    transaction to find nothing. Asked after the commit, so none is missed: a job queued
+    meanwhile rang its own doorbell, which found the cobot busy, after it had committed."""
+
+    def queued() -> bool:
+        return Job.objects.filter(cobot_id=cobot_id, state=JobState.QUEUED).exists()
+
+    dispatch.send_on_commit_if(queued, "run_job", job_id)
 
 
 def _dispatch_queues(case: Case) -> None:

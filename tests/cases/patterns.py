@@ -119,3 +119,39 @@ def unusable_outputs() -> dict[str, Any]:
     task = document["processes"][0]["transitions"][1]["task"]
     task["outputs"] = {"grip": "result.grip_force"}
     return document
+
+
+def func_hold(supported_by_cobot: bool = False) -> dict[str, Any]:
+    """The cobot holds the part (tc1) while the operator screws it (to1): tc1 supports to1 (func),
+    so to1 starts only while tc1 runs and tc1 completes only after to1 has. With
+    `supported_by_cobot` a second cobot actor (c2) screws it instead (tc2); map both actors to
+    one cobot and the cobot holds for a task it does itself."""
+    supported: dict[str, Any] = (
+        {"id": "tc2", "performer": "c2", "label": "screw the part", "task": {
+            "step": {"number": PICK}, "timeout": 30}}
+        if supported_by_cobot
+        else {"id": "to1", "performer": "o", "label": "screw the part"}
+    )  # fmt: skip
+    tasks: list[dict[str, Any]] = [
+        {"id": "split"},
+        {"id": "tc1", "performer": "c", "label": "hold the part", "task": {
+            "step": {"number": PICK}, "timeout": 30}},
+        supported,
+        {"id": "join"},
+    ]  # fmt: skip
+    other = supported["id"]
+    arcs = [
+        ["p0", "split"], ["split", "p1"], ["split", "p2"], ["p1", "tc1"], ["tc1", "p3"],
+        ["p2", other], [other, "p4"], ["p3", "join"], ["p4", "join"], ["join", "p5"],
+    ]  # fmt: skip
+    constraint = {"from": "tc1", "to": other, "type": "func"}
+    document = _document(
+        "Func hold", _process(tasks, arcs, [f"p{i}" for i in range(6)]), [constraint]
+    )
+    if supported_by_cobot:
+        document["actors"] = [
+            {"id": "c", "type": "cobot", "program": PROGRAM},
+            {"id": "c2", "type": "cobot", "program": PROGRAM},
+        ]
+        document["processes"][0]["actors"] = ["c", "c2"]
+    return document
