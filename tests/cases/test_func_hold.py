@@ -1,24 +1,30 @@
 """A func hold reserves its cobot: once a supporting cobot's step has run, its task is held until
 the supported task completes, and meanwhile no other case's job may move the cobot.
 
-The lease, the sweeper and the queue's reason here on the real job path without a gateway (a
-step's result is handed to finish_job as a worker would); the same with a simulated gateway, and
-the doorbell that starts the waiting case once the hold ends, in test_func_hold_on_a_gateway.py.
+The lease, the sweeper and the queue's reason on the job path without a gateway (a step's
+result is handed to finish_job as a worker would), then two cases on a simulated gateway, whose
+jobs run on this process's threads with no sweeper: only the hold's doorbell can start the
+waiting case's step.
 """
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 from typing import Any
 
 import pytest
 import redis
 from django.contrib.auth.models import User
 
-from hrc.cases import jobs, services
+from hrc.cases import dispatch, jobs, services
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.launcher import RedisProcess
-from hrc.cases.models import Case, Job
+from hrc.cases.models import Case, Job, WorkItem
 from hrc.cases.selectors import cobot_in_use
+from hrc.cases.simulation import Simulation
 from hrc.celery import app
 from hrc.cobots.models import Cobot
 from hrc.live.selectors import cobot_queues
@@ -147,3 +153,53 @@ def test_the_holding_cases_own_job_may_use_the_cobot_it_holds(
 
 def test_a_cobot_nobody_uses_is_not_in_use(organisation: Organisation) -> None:
     assert cobot_in_use(factories.make_cobot(organisation).pk) == ""
+
+
+def _until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.01)
+    raise AssertionError("condition not reached in time")
+
+
+def _screw(case_id: int, user: User) -> None:
+    screw = _until(lambda: _offered(case_id, "to1"))
+    services.start_work_item(screw, user=user)
+    services.complete_work_item(screw, user=user)
+
+
+def _offered(case_id: int, task: str) -> Any:
+    return WorkItem.objects.filter(case_id=case_id, task=task, state=WorkItemState.OFFERED).first()
+
+
+def test_on_a_gateway_the_other_cases_step_starts_once_the_hold_ends_and_not_before(
+    tmp_path: Path,
+) -> None:
+    with (
+        Simulation(func_hold(), tmp_path, time_scale=0.05, inline=False) as simulation,
+        ThreadPoolExecutor(max_workers=2) as pool,
+        dispatch.run_inline(pool),  # the doorbells run jobs on these threads; no sweeper
+    ):
+        holder, waiter = simulation.start_cases(2)
+        _until(lambda: Job.objects.filter(case_id=holder, state=JobState.SUCCEEDED).exists())
+        time.sleep(1.0)  # ample for a doorbell to start the other case's step (a pick is 0.1 s)
+
+        waiting = Job.objects.get(case_id=waiter)
+        assert waiting.state == JobState.QUEUED
+        assert waiting.waiting_for == f"holding for: screw the part, case {holder}"
+        assert simulation.executed_steps("c")[0] == 1  # the cobot has not moved since
+
+        _screw(holder, simulation.users["o"])
+        released = time.monotonic()
+        _until(lambda: Job.objects.filter(pk=waiting.pk, started_at__isnull=False).exists())
+        latency = time.monotonic() - released
+        _screw(waiter, simulation.users["o"])
+        _until(lambda: Case.objects.filter(pk=waiter, status=CaseStatus.COMPLETED).exists())
+        executions, _ = simulation.executed_steps("c")
+
+    assert latency < 2.0, f"the waiting step started {latency:.2f} s after the hold ended"
+    assert executions == 2
+    assert Case.objects.get(pk=holder).status == CaseStatus.COMPLETED
