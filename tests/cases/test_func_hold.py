@@ -1,7 +1,7 @@
 """A func hold reserves its cobot: once a supporting cobot's step has run, its task is held until
 the supported task completes, and meanwhile no other case's job may move the cobot.
 
-The lease, the sweeper and the queue's reason on the job path without a gateway (a step's
+The lease, the sweeper and the job's reason to wait on the job path without a gateway (a step's
 result is handed to finish_job as a worker would), then two cases on a simulated gateway, whose
 jobs run on this process's threads with no sweeper: only the hold's doorbell can start the
 waiting case's step.
@@ -27,7 +27,6 @@ from hrc.cases.selectors import cobot_in_use
 from hrc.cases.simulation import Simulation
 from hrc.celery import app
 from hrc.cobots.models import Cobot
-from hrc.live.selectors import cobot_queues
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PICK, func_hold
@@ -97,20 +96,6 @@ def test_another_case_waits_while_the_cobot_holds_and_goes_when_the_supported_ta
     assert lease is not None
     assert lease.case_id == waiter.pk
     assert cobot_in_use(cobot.pk) == f"step {PICK} of hold the part, case {waiter.pk} is running"
-
-
-def test_the_tablets_queue_says_what_the_cobot_holds_for(
-    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
-) -> None:
-    cobot, holder, _ = _two_cases_on_one_cobot(organisation, engineer, operator)
-    _hold(cobot, holder)
-    assert jobs.lease_next_job(cobot.pk) is None
-
-    [(_, _, queue)] = cobot_queues([cobot.pk])
-
-    assert queue["queue_length"] == 1  # the waiting case's job; the held one has run
-    assert queue["current"] is None
-    assert queue["waiting_for"] == f"holding for: screw the part, case {holder.pk}"
 
 
 def test_cancelling_the_holding_case_frees_the_cobot_at_once(

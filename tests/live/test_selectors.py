@@ -11,6 +11,7 @@ from hrc.cobots.models import Cobot
 from hrc.live.selectors import access_of, cobot_queues, snapshot
 from hrc.organisations.models import Organisation
 from tests import factories
+from tests.cases.patterns import func_hold
 
 pytestmark = pytest.mark.django_db
 
@@ -52,6 +53,26 @@ def test_a_cobots_queue_counts_its_jobs_names_the_running_step_and_the_first_rea
         "task": "tc1", "label": "place insert", "kind": "step",
         "step": running.command["number"], "attempt": 1,
     }  # fmt: skip
+
+
+def test_a_cobots_queue_says_what_another_cases_func_hold_waits_for(
+    organisation: Organisation, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer, draft=func_hold())
+    mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
+    holder, _ = (
+        factories.make_case(version, started_by=engineer, actor_mapping=mapping) for _ in range(2)
+    )
+    lease = jobs.lease_next_job(cobot.pk)
+    assert lease is not None
+    jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.5})  # held until to1 completes
+    assert jobs.lease_next_job(cobot.pk) is None
+
+    [(_, _, queue)] = cobot_queues([cobot.pk])
+
+    assert queue["queue_length"] == 1  # the other case's step; the holding one has run
+    assert queue["current"] is None
+    assert queue["waiting_for"] == f"holding for: screw the part, case {holder.pk}"
 
 
 def test_a_cell_tablet_gets_its_cells_cobots_and_where_every_other_cobot_of_ours_stands(
