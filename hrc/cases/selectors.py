@@ -1,7 +1,9 @@
 """Reads of cases, work items, jobs and incidents across the organisation wall.
 
 Every function starts from the user's organisations, so an outsider gets
-empty querysets (and the API 404s) whatever ids they try.
+empty querysets (and the API 404s) whatever ids they try; only the reads of
+what holds a cobot (for the lease, and for a cobot page that has checked its
+user already) take a cobot as it is.
 """
 
 from collections.abc import Iterable
