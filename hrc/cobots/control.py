@@ -103,6 +103,10 @@ def run_command(
         status, outcome = _failure(error)
         _finish(record, outcome, str(error))
         raise ControlError(str(error), status, record) from None
+    except BaseException:
+        # A bug, not the cobot's answer: the record must not hold the cobot until it goes stale.
+        _finish(record, CommandOutcome.FAILED, "The command failed unexpectedly; see the log.")
+        raise
     _finish(record, CommandOutcome.OK, "")
     return record
 
