@@ -22,6 +22,7 @@ from typing import Any, Final
 
 from django.contrib.auth.models import User
 from django.db import transaction
+from django.db.models import QuerySet
 from django.utils import timezone
 
 from hrc.cobots import hooks, urua
@@ -88,8 +89,8 @@ def run_command(
 
     Returns the row, finished with outcome ok. Raises ControlError: 400 when
     unconfirmed or when a program load names no program (nothing recorded);
-    409 when a case or another command is using the cobot, or the cobot
-    refused (a protective stop: in the gateway's words); 400 when the cobot
+    409 when the cobot is out of service, a case or another command is
+    using it, or the cobot refused (a protective stop: in the gateway's words); 400 when the cobot
     has no such program; 503 unreachable; 504 no answer in time; each
     recorded with its outcome and message.
     """
@@ -131,8 +132,12 @@ def _record(
     between the check and the row (the lease side sees the running command).
     """
     with transaction.atomic():
-        Cobot.objects.select_for_update(no_key=True).filter(pk=cobot.pk).first()
-        reason = hooks.cobot_in_use(cobot.pk) or _command_in_flight(cobot)
+        locked = Cobot.objects.select_for_update(no_key=True).filter(pk=cobot.pk).first()
+        reason = (
+            _out_of_service(locked or cobot)
+            or hooks.cobot_in_use(cobot.pk)
+            or _command_in_flight(cobot)
+        )
         record = CobotCommand.objects.create(
             cobot=cobot,
             command=command,
@@ -145,6 +150,12 @@ def _record(
     if reason:
         raise ControlError(reason, 409, record)
     return record
+
+
+def _out_of_service(cobot: Cobot) -> str:
+    if cobot.is_active:
+        return ""
+    return f"{cobot} is out of service (is_active is off); put it back in service first."
 
 
 def _command_in_flight(cobot: Cobot) -> str:
@@ -165,7 +176,7 @@ def _command_in_flight(cobot: Cobot) -> str:
     )
 
 
-def running_commands() -> Any:
+def running_commands() -> QuerySet[CobotCommand]:
     """The commands sent and not yet answered, leaving out those lost with their process."""
     return CobotCommand.objects.filter(
         outcome=CommandOutcome.RUNNING, requested_at__gte=timezone.now() - STALE_AFTER

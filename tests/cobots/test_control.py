@@ -217,6 +217,16 @@ def test_a_second_command_while_one_runs_is_refused(
     assert state(engineer_client, cobot)["RobotMode"] == urua.ROBOT_MODE_POWER_OFF
 
 
+def test_a_cobot_out_of_service_takes_no_command(engineer_client: APIClient, cobot: Cobot) -> None:
+    Cobot.objects.filter(pk=cobot.pk).update(is_active=False)
+
+    response = post(engineer_client, cobot, "power-on", CONFIRMED)
+
+    assert response.status_code == 409
+    assert "out of service" in response.data["detail"]
+    assert state(engineer_client, cobot)["RobotMode"] == urua.ROBOT_MODE_POWER_OFF
+
+
 def test_power_on_in_a_protective_stop_is_409_in_the_gateways_words_and_the_stop_stays(
     engineer_client: APIClient, cobot: Cobot
 ) -> None:
