@@ -87,12 +87,12 @@ def run_command(
 ) -> CobotCommand:
     """Carries out one command on the cobot for `by`, an engineer or admin the caller checked.
 
-    Returns the row, finished with outcome ok. Raises ControlError: 400 when
-    unconfirmed or when a program load names no program (nothing recorded);
-    409 when the cobot is out of service, a case or another command is
-    using it, or the cobot refused (a protective stop: in the gateway's words); 400 when the cobot
-    has no such program; 503 unreachable; 504 no answer in time; each
-    recorded with its outcome and message.
+    Returns the row, finished with outcome ok. Raises ControlError:
+    400 unconfirmed, or a load that names no program (nothing recorded);
+    409 the cobot is out of service, a case or another command is using it,
+    or the cobot refused (a protective stop: in the gateway's words);
+    400 the cobot has no such program; 503 unreachable; 504 no answer in
+    time. Each of these is recorded with its outcome and message.
     """
     arguments = _arguments(cobot, command, program)
     if not confirmed:
@@ -129,7 +129,8 @@ def _record(
     """The command's row: running, or refused (then raises ControlError 409 once it is saved).
 
     Under the cobot row lock a worker takes to lease a job, so no step starts
-    between the check and the row (the lease side sees the running command).
+    between the check and the row. (A lease does not yet wait for a command
+    in flight; running_commands() under the same lock is what it would ask.)
     """
     with transaction.atomic():
         locked = Cobot.objects.select_for_update(no_key=True).filter(pk=cobot.pk).first()
