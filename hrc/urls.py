@@ -13,7 +13,10 @@ urlpatterns = [
     path("", include("hrc.live.urls")),
     path("", include("hrc.cases.urls")),  # the supervisor pages: /cases/, /incidents/
     path("", include("hrc.patterns.urls")),  # the pattern editor: /patterns/
-    path("", include("hrc.analytics.urls")),  # /analytics/: figures per version, Gantt per case
+    path("", include("hrc.analytics.urls")),
+    path(
+        "", include("hrc.cobots.urls")
+    ),  # the cobot pages: /cobots/, control for engineers  # /analytics/: figures per version, Gantt per case
     # Sign-in, sign-out and password change for the tablets and the editor.
     path("accounts/", include("django.contrib.auth.urls")),
     path("api/schema/", SpectacularAPIView.as_view(), name="api-schema"),

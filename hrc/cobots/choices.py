@@ -21,3 +21,34 @@ class CredentialsKind(models.TextChoices):
     ENV = "env", "Environment variable"
     # Read at connect time from a file, e.g. a Docker or Kubernetes secret under /run/secrets/.
     FILE = "file", "File"
+
+
+class ControlCommand(models.TextChoices):
+    """What a person may ask of a cobot from its page or the API (hrc.cobots.control).
+
+    Nothing here clears a protective or emergency stop: a person does that at the cell.
+    """
+
+    # Powers the arm on and releases the brakes (URUA's PowerOn).
+    POWER_ON = "power-on", "Power on"
+    # Releases the brakes of an arm powered on to Idle.
+    BRAKE_RELEASE = "brake-release", "Release the brakes"
+    POWER_OFF = "power-off", "Power off"
+    # Selects a program by name (arguments: {"program": name}); nothing plays yet.
+    LOAD_PROGRAM = "load-program", "Load a program"
+    # Plays the loaded program, or resumes a paused one.
+    START_PROGRAM = "start-program", "Start the program"
+    PAUSE_PROGRAM = "pause-program", "Pause the program"
+    STOP_PROGRAM = "stop-program", "Stop the program"
+
+
+class CommandOutcome(models.TextChoices):
+    """What came of a control command."""
+
+    # Sent to the cobot, no answer yet; it holds the cobot against another command.
+    RUNNING = "running", "Running"
+    OK = "ok", "Done"
+    # Not carried out: a case was using the cobot, or the cobot said no (its message says why).
+    REFUSED = "refused", "Refused"
+    # The cobot could not be reached or did not answer in time: it may not have happened.
+    FAILED = "failed", "Failed"

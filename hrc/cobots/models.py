@@ -4,9 +4,10 @@ Credentials are referenced, not stored: `credentials_source` says where the
 worker reads them at connect time, so a database dump leaks no secrets.
 """
 
+from django.conf import settings
 from django.db import models
 
-from hrc.cobots.choices import DriverKind
+from hrc.cobots.choices import CommandOutcome, ControlCommand, DriverKind
 from hrc.cobots.validators import validate_cell, validate_credentials_source, validate_endpoint
 from hrc.organisations.models import Organisation
 
@@ -77,3 +78,41 @@ class Cobot(models.Model):
 
     def __str__(self) -> str:
         return self.name
+
+
+class CobotCommand(models.Model):
+    """A control command a person gave a cobot (hrc.cobots.control): who, what, when, what came of it.
+
+    Written before the command goes out, so the row shows it while it runs and
+    holds the cobot against a second one; never deleted but with its cobot.
+    """
+
+    cobot = models.ForeignKey(Cobot, on_delete=models.CASCADE, related_name="commands")
+    command = models.CharField(max_length=20, choices=ControlCommand.choices)
+    arguments = models.JSONField(
+        default=dict, blank=True, help_text='What the command took, e.g. {"program": "pick"}.'
+    )
+    requested_by = models.ForeignKey(
+        settings.AUTH_USER_MODEL,
+        on_delete=models.SET_NULL,
+        null=True,
+        related_name="+",
+        help_text="The person who gave the command (empty once their account is deleted).",
+    )
+    requested_at = models.DateTimeField(auto_now_add=True)
+    finished_at = models.DateTimeField(
+        null=True, blank=True, help_text="When the cobot answered, or the command was refused."
+    )
+    outcome = models.CharField(
+        max_length=10, choices=CommandOutcome.choices, default=CommandOutcome.RUNNING
+    )
+    message = models.TextField(
+        blank=True, help_text="Why it was refused or failed, in the cobot's words when it said."
+    )
+
+    class Meta:
+        ordering = ["-requested_at", "-id"]
+        indexes = [models.Index(fields=["cobot", "-requested_at"])]
+
+    def __str__(self) -> str:
+        return f"{self.get_command_display()} on {self.cobot_id} ({self.outcome})"

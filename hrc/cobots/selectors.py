@@ -4,7 +4,7 @@ from typing import Any
 
 from django.db.models import QuerySet
 
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.selectors import AnyUser, organisations_of
 
 
@@ -13,6 +13,11 @@ def cobots_visible_to(user: AnyUser) -> QuerySet[Cobot]:
     return Cobot.objects.filter(organisation__in=organisations_of(user)).select_related(
         "organisation"
     )
+
+
+def commands_of(cobot: Cobot) -> QuerySet[CobotCommand]:
+    """The control commands people gave the cobot, newest first, with who gave them."""
+    return CobotCommand.objects.filter(cobot=cobot).select_related("requested_by")
 
 
 def live_state(cobot: Cobot, *, timeout: float = 3.0) -> dict[str, Any]:

@@ -13,7 +13,7 @@ import pytest
 from django.contrib.auth.models import User
 from rest_framework.test import APIClient
 
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.models import Organisation
 from hrc.patterns import services
 from hrc.patterns.models import PatternModel, PatternVersion
@@ -55,6 +55,30 @@ OBJECT_ENDPOINTS = [
     Endpoint("patch", "/api/cobots/{cobot}/", write=True, body={"name": "overwritten"}),
     Endpoint("delete", "/api/cobots/{cobot}/", write=True),
 ]
+CONFIRMED = {"confirm": True}
+# A person's control of a cobot (hrc.cobots.control): the wall and the role decide before
+# the cobot is reached, so these need no gateway.
+COBOT_CONTROL_ENDPOINTS = [
+    *(
+        Endpoint("post", f"/api/cobots/{{cobot}}/{action}/", write=True, body=CONFIRMED)
+        for action in (
+            "power-on",
+            "brake-release",
+            "power-off",
+            "program/start",
+            "program/pause",
+            "program/stop",
+        )
+    ),
+    Endpoint(
+        "post", "/api/cobots/{cobot}/program/", write=True, body={"program": "x", "confirm": True}
+    ),
+    Endpoint("get", "/api/cobots/{cobot}/state/", write=False),
+    Endpoint("get", "/api/cobots/{cobot}/registers/", write=False),
+    Endpoint("get", "/api/cobots/{cobot}/registers/?names=Int24", write=False),
+    Endpoint("get", "/api/cobots/{cobot}/programs/", write=False),
+    Endpoint("get", "/api/cobots/{cobot}/commands/", write=False),
+]
 LIST_ENDPOINTS = ["/api/organisations/", "/api/patterns/", "/api/pattern-versions/", "/api/cobots/"]
 CREATE_ENDPOINTS = [
     Endpoint("post", "/api/patterns/", write=True, body=PATTERN_BODY),
@@ -63,6 +87,7 @@ CREATE_ENDPOINTS = [
 ]
 ALL_ENDPOINTS = [
     *OBJECT_ENDPOINTS,
+    *COBOT_CONTROL_ENDPOINTS,
     *CREATE_ENDPOINTS,
     *(Endpoint("get", path, write=False) for path in LIST_ENDPOINTS),
     Endpoint("get", "/api/organisations/me/", write=False),
@@ -102,12 +127,13 @@ def world(organisation: Organisation, engineer: User) -> World:
     return World(organisation, pattern, version, factories.make_cobot(organisation, name="cobot1"))
 
 
-@pytest.mark.parametrize("endpoint", OBJECT_ENDPOINTS, ids=str)
+@pytest.mark.parametrize("endpoint", OBJECT_ENDPOINTS + COBOT_CONTROL_ENDPOINTS, ids=str)
 def test_an_outsider_gets_404_for_every_object_of_another_organisation(
     outsider_client: APIClient, world: World, endpoint: Endpoint
 ) -> None:
     assert endpoint.call(outsider_client, world.ids).status_code == 404
     world.assert_untouched()
+    assert not CobotCommand.objects.exists()
 
 
 @pytest.mark.parametrize("path", LIST_ENDPOINTS)
@@ -132,7 +158,9 @@ def test_a_user_without_membership_sees_empty_lists(
 
 
 @pytest.mark.parametrize(
-    "endpoint", [e for e in OBJECT_ENDPOINTS + CREATE_ENDPOINTS if e.write], ids=str
+    "endpoint",
+    [e for e in OBJECT_ENDPOINTS + COBOT_CONTROL_ENDPOINTS + CREATE_ENDPOINTS if e.write],
+    ids=str,
 )
 def test_an_operator_gets_403_on_every_write(
     operator_client: APIClient, world: World, endpoint: Endpoint
@@ -143,6 +171,7 @@ def test_an_operator_gets_403_on_every_write(
     world.assert_untouched()
     assert PatternModel.objects.count() == 1
     assert Cobot.objects.count() == 1
+    assert not CobotCommand.objects.exists()
 
 
 @pytest.mark.parametrize("endpoint", [e for e in OBJECT_ENDPOINTS if not e.write], ids=str)

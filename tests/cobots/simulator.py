@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import asyncio
+import json
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from asyncua import Client
 
 from hrc.cobots import urua
+from hrc.cobots.gateway.sim.backend import SimBackend
+from hrc.cobots.gateway.sim.robot import IDLE
 
 # Coexistence_PickAndPlace: 1 home, 2 move to a pose (ws 0 part box), 3 pick (a 2 s wait).
 PROGRAM = "Coexistence_PickAndPlace"
@@ -34,3 +38,41 @@ async def until(condition: Callable[[], object], timeout: float = 5.0) -> None:
     while not condition():
         assert time.monotonic() < deadline, "condition not reached in time"
         await asyncio.sleep(0.005)
+
+
+def save_arm_powered_to_idle(state_file: Path, name: str = "cobot1") -> None:
+    """Saves a simulator state whose arm a person powered on at the pendant, brakes still on.
+
+    The simulator's own PowerOn goes on to Running; a controller left in Idle
+    is what a gateway (re)started beside such an arm finds.
+    """
+
+    async def fresh_state() -> None:
+        backend = SimBackend(name, time_scale=0, state_file=state_file)
+        await backend.start(_NoSpace(), _ignore)
+        await backend.close()
+
+    asyncio.run(fresh_state())
+    leave_arm_in_idle(state_file)
+
+
+def leave_arm_in_idle(state_file: Path) -> None:
+    """Edits a saved simulator state: its arm is powered, in Idle, brakes on."""
+    data = json.loads(state_file.read_text(encoding="utf-8"))
+    data["arm"]["robot_mode"] = IDLE
+    state_file.write_text(json.dumps(data), encoding="utf-8")
+
+
+class _NoSpace:
+    async def add_variable(self, *args: Any, **kwargs: Any) -> None:
+        return None
+
+    async def add_method(self, *args: Any, **kwargs: Any) -> None:
+        return None
+
+    async def drop_connections(self) -> None:
+        return None
+
+
+async def _ignore(values: Any) -> None:
+    return None

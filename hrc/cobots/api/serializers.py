@@ -1,8 +1,10 @@
 """How cobots look over the API. Credentials appear only as their source, never as a secret."""
 
+from typing import Any
+
 from rest_framework import serializers
 
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.api.serializers import MemberOrganisationField
 
 
@@ -39,3 +41,68 @@ class CobotSerializer(serializers.ModelSerializer[Cobot]):
         ):
             raise serializers.ValidationError("A cobot cannot move to another organisation.")
         return organisation
+
+
+class ControlRequestSerializer(serializers.Serializer[dict[str, Any]]):
+    confirm = serializers.BooleanField(
+        default=False,
+        help_text="Must be true: a person confirms every command to a cobot.",
+    )
+
+
+class LoadProgramRequestSerializer(ControlRequestSerializer):
+    program = serializers.CharField(
+        required=False,
+        allow_blank=True,
+        default="",
+        max_length=300,
+        help_text="The program's name as the cobot lists it (a directory and .urp are ignored).",
+    )
+
+
+class CobotCommandSerializer(serializers.ModelSerializer[CobotCommand]):
+    """A control command as the record shows it."""
+
+    requested_by: serializers.SlugRelatedField[Any] = serializers.SlugRelatedField(
+        slug_field="username", read_only=True, allow_null=True
+    )
+
+    class Meta:
+        model = CobotCommand
+        fields = [
+            "id",
+            "cobot",
+            "command",
+            "arguments",
+            "requested_by",
+            "requested_at",
+            "finished_at",
+            "outcome",
+            "message",
+        ]
+        read_only_fields = fields
+
+
+class CommandRefusalSerializer(serializers.Serializer[dict[str, Any]]):
+    """Why a command was not carried out; `command` is its record when it was recorded."""
+
+    detail = serializers.CharField()
+    command = CobotCommandSerializer(required=False)
+
+
+class RegistersSerializer(serializers.Serializer[dict[str, Any]]):
+    inputs = serializers.DictField(help_text="Input registers (what clients write) by name.")
+    outputs = serializers.DictField(help_text="Output registers (what the program writes) by name.")
+
+
+class CobotStateSerializer(serializers.Serializer[dict[str, Any]]):
+    """What the cobot reports now (hrc.cobots.selectors.live_state)."""
+
+    reachable = serializers.BooleanField()
+    error = serializers.CharField(required=False, help_text="Why it cannot be reached.")
+    transient = serializers.BooleanField(required=False, help_text="Whether trying again may help.")
+    RobotMode = serializers.CharField(required=False)
+    SafetyMode = serializers.CharField(required=False)
+    ProgramState = serializers.CharField(required=False)
+    CurrentProgram = serializers.CharField(required=False)
+    LastError = serializers.CharField(required=False)

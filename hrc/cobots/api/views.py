@@ -1,13 +1,87 @@
-"""Cobots of your organisations: members read, engineers and admins write."""
+"""Cobots of your organisations: members read, engineers and admins write and control them.
+
+Control (hrc.cobots.control): engineers and admins of the cobot's
+organisation power it, release its brakes and run its programs, each with
+`"confirm": true`, each recorded; operators read the state, the registers
+and the record (403 on commands); another organisation's cobot is 404.
+Nothing clears a protective or emergency stop, and registers are not
+written here (a register write can move the robot: the step handshake's job).
+
+The prototype's client service (shared/reference/prototype-artefacts.md §2.2) maps so:
+
+| prototype client service               | hrc                                                     |
+| -------------------------------------- | ------------------------------------------------------- |
+| `GET /cobots`                          | `GET /api/cobots/`                                      |
+| `POST /cobots/:id/power_on`            | `POST /api/cobots/{id}/power-on/` (then Running)        |
+| (PowerOn's brake release once Idle)    | `POST /api/cobots/{id}/brake-release/`                  |
+| `POST /cobots/:id/power_off`           | `POST /api/cobots/{id}/power-off/`                      |
+| `GET /cobots/:id/programs`             | `GET /api/cobots/{id}/programs/`                        |
+| `POST /cobots/:id/programs/*/select`   | `POST /api/cobots/{id}/program/` `{"program": name}`    |
+| `POST /cobots/:id/programs/start`      | `POST /api/cobots/{id}/program/start/`                  |
+| `POST /cobots/:id/programs/pause`      | `POST /api/cobots/{id}/program/pause/`                  |
+| `POST /cobots/:id/programs/stop`       | `POST /api/cobots/{id}/program/stop/`                   |
+| `GET /cobots/:id/node/*` (registers)   | `GET /api/cobots/{id}/registers/?names=Int24,Bit64`     |
+| `GET /cobots/:id/node/State/*`         | `GET /api/cobots/{id}/state/`                           |
+| `PUT /cobots/:id/node/*`, `/position/` | not offered: steps go through cases (`/api/jobs/`)      |
+| `POST /cobots/:id/handshake/:bit`      | not offered: the worker runs the handshake of each step |
+| (none: who did what, when)             | `GET /api/cobots/{id}/commands/`                        |
+
+Every command body also carries `"confirm": true`.
+"""
+
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from django.db.models import QuerySet
+from drf_spectacular.types import OpenApiTypes
+from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import serializers, viewsets
+from rest_framework.decorators import action
+from rest_framework.request import Request
+from rest_framework.response import Response
 
+from hrc.api.exceptions import Rejected
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
-from hrc.cobots import services
-from hrc.cobots.api.serializers import CobotSerializer
-from hrc.cobots.models import Cobot
-from hrc.cobots.selectors import cobots_visible_to
+from hrc.cobots import control, services
+from hrc.cobots.api.serializers import (
+    CobotCommandSerializer,
+    CobotSerializer,
+    CobotStateSerializer,
+    CommandRefusalSerializer,
+    ControlRequestSerializer,
+    LoadProgramRequestSerializer,
+    RegistersSerializer,
+)
+from hrc.cobots.choices import ControlCommand
+from hrc.cobots.models import Cobot, CobotCommand
+from hrc.cobots.selectors import cobots_visible_to, commands_of, live_state
+
+COMMAND_RESPONSES: dict[int | str, Any] = {
+    200: CobotCommandSerializer,
+    **dict.fromkeys((400, 403, 404, 409, 502, 503, 504), CommandRefusalSerializer),
+}
+Action = TypeVar("Action", bound=Callable[..., Response])
+
+READ_RESPONSES: dict[int | str, Any] = dict.fromkeys((400, 404, 502, 503), CommandRefusalSerializer)
+
+
+def _command_schema(
+    summary: str,
+    request: type[serializers.Serializer[Any]] = ControlRequestSerializer,
+) -> Callable[[Action], Action]:
+    decorate: Callable[[Action], Action] = extend_schema(
+        summary=summary,
+        description=(
+            "Engineers and admins of the cobot's organisation, with `confirm: true` (400 "
+            "without). Recorded with who and when (`commands/`). 409 while a case's step runs "
+            "on the cobot, while another command on it runs, or when the cobot refuses (a "
+            "protective stop: in the gateway's words; nothing here clears one); 503 when the "
+            "cobot cannot be reached, 504 when it did not answer in time."
+        ),
+        request=request,
+        responses=COMMAND_RESPONSES,
+    )
+    return decorate
 
 
 class CobotViewSet(viewsets.ModelViewSet[Cobot]):
@@ -32,3 +106,122 @@ class CobotViewSet(viewsets.ModelViewSet[Cobot]):
 
     def perform_destroy(self, instance: Cobot) -> None:
         services.delete_cobot(instance)
+
+    # Control ---------------------------------------------------------------------------
+
+    @_command_schema("Power on and release the brakes (URUA's PowerOn)")
+    @action(detail=True, methods=["post"], url_path="power-on")
+    def power_on(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.POWER_ON)
+
+    @_command_schema("Release the brakes of a cobot powered on to Idle")
+    @action(detail=True, methods=["post"], url_path="brake-release")
+    def brake_release(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.BRAKE_RELEASE)
+
+    @_command_schema("Power off (stops the program first)")
+    @action(detail=True, methods=["post"], url_path="power-off")
+    def power_off(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.POWER_OFF)
+
+    @_command_schema(
+        "Load (select) a program; a playing one must be stopped first", LoadProgramRequestSerializer
+    )
+    @action(detail=True, methods=["post"], url_path="program")
+    def load_program(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.LOAD_PROGRAM, LoadProgramRequestSerializer)
+
+    @_command_schema("Start (or resume) the loaded program")
+    @action(detail=True, methods=["post"], url_path="program/start")
+    def start_program(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.START_PROGRAM)
+
+    @_command_schema("Pause the playing program")
+    @action(detail=True, methods=["post"], url_path="program/pause")
+    def pause_program(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.PAUSE_PROGRAM)
+
+    @_command_schema("Stop the program")
+    @action(detail=True, methods=["post"], url_path="program/stop")
+    def stop_program(self, request: Request, pk: str | None = None) -> Response:
+        return self._run(request, ControlCommand.STOP_PROGRAM)
+
+    def _run(
+        self,
+        request: Request,
+        command: ControlCommand,
+        body_serializer: type[ControlRequestSerializer] = ControlRequestSerializer,
+    ) -> Response:
+        cobot = self.get_object()  # the wall (404) and the role (403) before anything else
+        body = body_serializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        try:
+            record = control.run_command(
+                cobot,
+                command,
+                by=request.user,  # type: ignore[arg-type]  # authenticated: the permission
+                confirmed=body.validated_data["confirm"],
+                program=body.validated_data.get("program", ""),
+            )
+        except control.ControlError as error:
+            payload: dict[str, Any] = {"detail": str(error)}
+            if error.record is not None:
+                payload["command"] = CobotCommandSerializer(error.record).data
+            raise Rejected(payload, error.status) from None
+        return Response(CobotCommandSerializer(record).data)
+
+    # Reads -----------------------------------------------------------------------------
+
+    @extend_schema(
+        summary="The cobot's state now",
+        description="Robot mode, safety mode, program state and program, last error; "
+        "`reachable: false` with the reason when the cobot cannot be reached.",
+        responses={200: CobotStateSerializer, 404: CommandRefusalSerializer},
+    )
+    @action(detail=True, methods=["get"])
+    def state(self, request: Request, pk: str | None = None) -> Response:
+        return Response(live_state(self.get_object()))
+
+    @extend_schema(
+        summary="The cobot's input and output registers",
+        description="All of them, or those `names` lists; a name that is no register is 400.",
+        parameters=[
+            OpenApiParameter(
+                "names", OpenApiTypes.STR, description="Comma-separated, e.g. Int24,Bit64."
+            )
+        ],
+        responses={200: RegistersSerializer, **READ_RESPONSES},
+    )
+    @action(detail=True, methods=["get"])
+    def registers(self, request: Request, pk: str | None = None) -> Response:
+        cobot = self.get_object()
+        try:
+            names = control.register_names(request.query_params.get("names"))
+            registers = control.read_registers(cobot, names)
+        except control.ControlError as error:
+            raise Rejected({"detail": str(error)}, error.status) from None
+        return Response({"inputs": registers.inputs, "outputs": registers.outputs})
+
+    @extend_schema(
+        summary="The programs the cobot can load",
+        responses={
+            200: serializers.ListSerializer(child=serializers.CharField()),
+            **READ_RESPONSES,
+        },
+    )
+    @action(detail=True, methods=["get"])
+    def programs(self, request: Request, pk: str | None = None) -> Response:
+        cobot = self.get_object()
+        try:
+            return Response(control.programs(cobot))
+        except control.ControlError as error:
+            raise Rejected({"detail": str(error)}, error.status) from None
+
+    @extend_schema(
+        summary="The cobot's control commands, newest first",
+        responses={200: CobotCommandSerializer(many=True), 404: CommandRefusalSerializer},
+    )
+    @action(detail=True, methods=["get"])
+    def commands(self, request: Request, pk: str | None = None) -> Response:
+        page: list[CobotCommand] = self.paginate_queryset(commands_of(self.get_object()))  # type: ignore[arg-type,assignment]
+        return self.get_paginated_response(CobotCommandSerializer(page, many=True).data)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import asyncio
 import os
 import threading
-from collections.abc import Callable, Coroutine, Mapping
+from collections.abc import Callable, Coroutine, Mapping, Sequence
 from typing import Any, TypeVar
 
 from django.conf import settings
@@ -88,6 +88,9 @@ class SyncDriver:
 
     def read(self, path: str) -> Any:
         return _LOOP.run(self.driver.read(path), self.driver.connect_timeout)
+
+    def read_many(self, paths: Sequence[str]) -> dict[str, Any]:
+        return _LOOP.run(self.driver.read_many(paths), self.driver.connect_timeout)
 
     def write(self, values: Mapping[str, Any]) -> None:
         _LOOP.run(self.driver.write(values), self.driver.connect_timeout)

@@ -104,6 +104,14 @@ class Backend(abc.ABC):
         """Powers the arm on, waits for Idle and releases the brakes (with a timeout)."""
 
     @abc.abstractmethod
+    async def brake_release(self) -> None:
+        """Releases the brakes of a robot powered on to Idle and waits for Running.
+
+        Returns at once when it is Running already; raises CommandFailed in a
+        safety stop or in any other mode (powered off: power it on first).
+        """
+
+    @abc.abstractmethod
     async def power_off(self) -> None: ...
 
     @abc.abstractmethod

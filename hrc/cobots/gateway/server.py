@@ -141,6 +141,9 @@ class Gateway:
                 [("content", "String")],
             ),
             ("PowerOn", _returning_nothing(backend.power_on), []),
+            # Not in URUA, whose PowerOn also released the brakes (as ours still does): the
+            # second half on its own, for a robot powered on to Idle at the pendant.
+            ("BrakeRelease", _returning_nothing(backend.brake_release), []),
             ("PowerOff", _returning_nothing(backend.power_off), []),
             (
                 "RobotMode/AutomaticMode",

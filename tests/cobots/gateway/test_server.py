@@ -122,6 +122,22 @@ async def test_a_failed_command_answers_bad_with_a_message(client: Client) -> No
         await root.call_method("2:SelectProgram", ua.Variant(3, ua.VariantType.Int32))
 
 
+async def test_brake_release_is_a_method_of_its_own_that_powering_on_does_not_need(
+    client: Client,
+) -> None:
+    root = node(client, "ns=2;s=cobot1")
+    mode = node(client, "ns=2;s=/cobot1/State/RobotMode")
+    with pytest.raises(ua.UaStatusCodeError, match="BadInvalidState"):
+        await root.call_method("2:BrakeRelease")  # powered off: the brakes stay on
+    assert "Power it on first" in await node(client, "ns=2;s=/cobot1/State/LastError").read_value()
+    assert await mode.read_value() == "Power Off"
+
+    await root.call_method("2:PowerOn")  # as in URUA: powers on and releases the brakes
+    assert await mode.read_value() == "Running"
+    await root.call_method("2:BrakeRelease")
+    assert await mode.read_value() == "Running"
+
+
 async def test_the_gateway_never_closes_a_safety_popup(client: Client) -> None:
     messaging = node(client, "ns=2;s=/cobot1/Messaging")
     with pytest.raises(ua.UaStatusCodeError, match="BadUserAccessDenied"):

@@ -19,7 +19,7 @@ import contextlib
 import dataclasses
 import logging
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -565,6 +565,23 @@ class OpcUaDriver(CobotDriver):
             raise self._refusal(f"Reading {path}", _status_name(error), path) from None
         except _CONNECTION_ERRORS as error:
             raise self._unreachable(error) from None
+
+    async def read_many(self, paths: Sequence[str]) -> dict[str, Any]:
+        """The values of the nodes at `paths` under the cobot's root, in one read request."""
+        await self._ensure_session(self._deadline(self.connect_timeout))
+        assert self._client is not None
+        nodes = [self._client.get_node(urua.node_id(self.name, path)) for path in paths]
+        try:
+            results = await self._client.read_attributes(nodes)
+        except _CONNECTION_ERRORS as error:
+            raise self._unreachable(error) from None
+        for path, result in zip(paths, results, strict=True):
+            if not result.StatusCode.is_good():
+                raise self._refusal(f"Reading {path}", result.StatusCode.name, path)
+        return {
+            path: result.Value.Value if result.Value is not None else None
+            for path, result in zip(paths, results, strict=True)
+        }
 
     async def write(self, values: Mapping[str, Any]) -> None:
         """Writes values by path in one request; register values are checked here first."""

@@ -150,6 +150,12 @@ class SimBackend(Backend):
         finally:
             await self._persist()
 
+    async def brake_release(self) -> None:
+        try:
+            await self.robot.brake_release()
+        finally:
+            await self._persist()
+
     async def power_off(self) -> None:
         """Stops the program, then cuts power."""
         await self._stop_program()

@@ -222,9 +222,30 @@ class Robot:
                 await self._power_stage(BOOT_SECONDS, generation)
                 await self.update(robot_mode=IDLE)
             if self.state.robot_mode == IDLE:
-                # The brakes click open one joint after another.
-                await self._power_stage(BRAKE_RELEASE_SECONDS, generation)
-                await self.update(robot_mode=RUNNING)
+                await self._release_brakes(generation)
+
+    async def brake_release(self) -> None:
+        """Releases the brakes of an arm powered on to Idle; returns when Running.
+
+        Raises CommandFailed in a protective stop, or when the arm is not
+        Idle (powered off, booting); an arm already Running is left as it is.
+        """
+        self._check_safe_to_power()
+        async with self._power_lock:
+            mode = self.state.robot_mode
+            if mode == RUNNING:
+                return
+            if mode != IDLE:
+                raise CommandFailed(
+                    f"The robot is in mode {mode!r}; the brakes are released from Idle. "
+                    "Power it on first (PowerOn releases the brakes as well)."
+                )
+            await self._release_brakes(self._power_generation)
+
+    async def _release_brakes(self, generation: int) -> None:
+        # The brakes click open one joint after another.
+        await self._power_stage(BRAKE_RELEASE_SECONDS, generation)
+        await self.update(robot_mode=RUNNING)
 
     async def _power_stage(self, seconds: float, generation: int) -> None:
         await self.clock.sleep(seconds)

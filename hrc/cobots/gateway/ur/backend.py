@@ -177,6 +177,22 @@ class URBackend(Backend):
         if mode != DASHBOARD_IDLE:
             await self._command("power on", "Powering on", "Power on")
             await self._wait_for_mode(DASHBOARD_IDLE, "Power on")
+        await self._release_brakes()
+
+    async def brake_release(self) -> None:
+        await self._refuse_in_safety_stop("Brake release")
+        mode = await self._robot_mode()
+        if mode == DASHBOARD_RUNNING:
+            return
+        if mode != DASHBOARD_IDLE:
+            raise CommandFailed(
+                f"Brake release refused: the robot is {mode}; the brakes are released from "
+                "IDLE. Power it on first (PowerOn releases the brakes as well).",
+                "BadInvalidState",
+            )
+        await self._release_brakes()
+
+    async def _release_brakes(self) -> None:
         await self._command("brake release", "Brake releasing", "Brake release")
         await self._wait_for_mode(DASHBOARD_RUNNING, "Brake release")
 

@@ -1,11 +1,14 @@
 """Power, safety, modes and program commands, as a client of the gateway sees them."""
 
+from pathlib import Path
+
 import pytest
 
 from hrc.cobots import urua
 from hrc.cobots.gateway.backend import CommandFailed
 from hrc.cobots.gateway.sim.programs import PROGRAMS
 from tests.cobots.gateway.sim.cell import Cell
+from tests.cobots.simulator import leave_arm_in_idle
 
 PICK = "Coexistence_PickAndPlace"
 
@@ -42,6 +45,54 @@ async def test_power_on_when_running_returns_at_once(cell: Cell) -> None:
     mark = cell.recorder.mark()
     await cell.backend.power_on()
     assert cell.recorder.since(mark, urua.STATE_ROBOT_MODE) == []
+
+
+async def idle_cell(state_file: Path) -> Cell:
+    """A cell whose arm was powered on to Idle (brakes on) before the gateway started."""
+    await (await Cell.start(state_file=state_file)).close()
+    leave_arm_in_idle(state_file)
+    return await Cell.start(state_file=state_file)
+
+
+async def test_brake_release_takes_an_idle_arm_to_running(tmp_path: Path) -> None:
+    cell = await idle_cell(tmp_path / "sim.json")
+    try:
+        assert cell.value(urua.STATE_ROBOT_MODE) == "Idle"
+        await cell.backend.brake_release()
+        assert cell.recorder.series(urua.STATE_ROBOT_MODE) == ["Idle", "Running"]
+        assert cell.value("State/JointMode") == "JOINT_RUNNING_MODE"
+    finally:
+        await cell.close()
+
+
+async def test_brake_release_of_a_powered_off_arm_is_refused_and_says_power_it_on(
+    cell: Cell,
+) -> None:
+    with pytest.raises(CommandFailed, match="Power it on first") as refused:
+        await cell.backend.brake_release()
+    assert refused.value.status == "BadInvalidState"
+    assert cell.value(urua.STATE_ROBOT_MODE) == "Power Off"
+
+
+async def test_brake_release_of_a_running_arm_changes_nothing(cell: Cell) -> None:
+    await cell.backend.power_on()
+    mark = cell.recorder.mark()
+    await cell.backend.brake_release()
+    assert cell.recorder.since(mark, urua.STATE_ROBOT_MODE) == []
+
+
+async def test_brake_release_in_a_protective_stop_is_refused_and_the_stop_stays(
+    tmp_path: Path,
+) -> None:
+    cell = await idle_cell(tmp_path / "sim.json")
+    try:
+        await cell.space.call("Simulator/InjectFault", "protective-stop", "")
+        with pytest.raises(CommandFailed, match="teach pendant"):
+            await cell.backend.brake_release()
+        assert cell.value(urua.STATE_ROBOT_MODE) == "Idle"
+        assert cell.value(urua.STATE_SAFETY_MODE) == "SAFETY_MODE_PROTECTIVE_STOP"
+    finally:
+        await cell.close()
 
 
 async def test_power_on_in_a_protective_stop_says_a_person_must_clear_it(cell: Cell) -> None:

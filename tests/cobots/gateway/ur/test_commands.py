@@ -8,7 +8,7 @@ from hrc.cobots import urua
 from hrc.cobots.gateway.backend import CommandFailed
 from hrc.cobots.gateway.ur.backend import URBackend
 from tests.cobots.fake_ur import FakeUR
-from tests.cobots.fake_ur.controller import RUNNING
+from tests.cobots.fake_ur.controller import IDLE, POWER_OFF, RUNNING
 from tests.cobots.gateway.ur.conftest import Published
 
 # What the software must never send: only a person at the pendant clears these.
@@ -30,6 +30,43 @@ async def test_power_on_of_a_running_robot_sends_nothing(ready: URBackend, fake_
     await ready.power_on()
 
     assert "power on" not in fake_ur.controller.dashboard_commands
+
+
+async def test_brake_release_from_idle_sends_brake_release_and_waits_for_running(
+    backend: URBackend, published: Published, fake_ur: FakeUR
+) -> None:
+    fake_ur.controller.robot_mode = IDLE  # powered on at the pendant, brakes still on
+
+    await backend.brake_release()
+
+    assert fake_ur.controller.robot_mode == RUNNING
+    assert "brake release" in fake_ur.controller.dashboard_commands
+    assert "power on" not in fake_ur.controller.dashboard_commands
+    await published.equals(urua.STATE_ROBOT_MODE, urua.ROBOT_MODE_RUNNING)
+
+
+async def test_brake_release_of_a_powered_off_robot_is_refused_without_a_command(
+    backend: URBackend, fake_ur: FakeUR
+) -> None:
+    with pytest.raises(CommandFailed, match="Power it on first") as refused:
+        await backend.brake_release()
+
+    assert refused.value.status == "BadInvalidState"
+    assert "brake release" not in fake_ur.controller.dashboard_commands
+    assert fake_ur.controller.robot_mode == POWER_OFF
+
+
+async def test_brake_release_in_a_protective_stop_is_refused_and_never_unlocks(
+    backend: URBackend, fake_ur: FakeUR
+) -> None:
+    fake_ur.controller.robot_mode = IDLE
+    fake_ur.controller.protective_stop()
+
+    with pytest.raises(CommandFailed, match="teach pendant"):
+        await backend.brake_release()
+
+    assert not set(NEVER_SENT) & set(fake_ur.controller.dashboard_commands)
+    assert "brake release" not in fake_ur.controller.dashboard_commands
 
 
 async def test_a_loaded_program_plays(

@@ -1,0 +1,85 @@
+"""The cobot page in a real browser: an engineer powers a powered-off cobot on.
+
+The cobot is a simulated gateway process in its boot state (powered off, no
+program); the server is a separate process (live_url), which reaches it over
+OPC UA as it would a plant's.
+"""
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+from django.contrib.auth.models import User
+from playwright.sync_api import Page, expect
+
+from hrc.cobots import urua
+from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.models import CobotCommand
+from hrc.organisations.models import Organisation
+from tests import factories
+
+pytestmark = pytest.mark.django_db(transaction=True)
+
+SignIn = Callable[[Page, User], None]
+Screenshot = Callable[[Page, str], Path]
+
+
+@pytest.fixture
+def gateway(tmp_path: Path) -> Iterator[GatewayProcess]:
+    process = GatewayProcess("cobot1", tmp_path / "cobot1.json").start()
+    yield process
+    process.stop()
+
+
+def test_an_engineer_powers_a_cobot_on_through_the_confirmation_dialog(
+    page: Page,
+    live_url: str,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+    engineer: User,
+    organisation: Organisation,
+    gateway: GatewayProcess,
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot1", endpoint=gateway.endpoint)
+    sign_in(page, engineer)
+    page.goto(f"{live_url}/cobots/")
+    page.get_by_role("link", name="cobot1").click()
+    state = page.locator('#state [data-field="RobotMode"]')
+    expect(state).to_have_text(urua.ROBOT_MODE_POWER_OFF)
+
+    page.get_by_role("button", name="Power on").click()
+    dialog = page.get_by_role("dialog")
+    expect(dialog).to_contain_text("Power on cobot1?")
+    assert not CobotCommand.objects.exists()  # nothing goes out before the confirmation
+    dialog.get_by_role("button", name="Confirm").click()
+
+    expect(page.locator("#outcome")).to_have_text("Power on: cobot1 done.", timeout=20_000)
+    expect(state).to_have_text(urua.ROBOT_MODE_RUNNING)
+    newest = page.locator("#commands tbody tr").first
+    expect(newest).to_contain_text(engineer.username)
+    expect(newest).to_contain_text("Power on")
+    expect(newest).to_contain_text("Done")
+    screenshot(page, "cobot-powered-on")
+    record = CobotCommand.objects.get()
+    assert (record.cobot_id, record.requested_by, record.outcome) == (cobot.pk, engineer, "ok")
+
+
+def test_a_cancelled_confirmation_sends_nothing(
+    page: Page,
+    live_url: str,
+    sign_in: SignIn,
+    engineer: User,
+    organisation: Organisation,
+    gateway: GatewayProcess,
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot1", endpoint=gateway.endpoint)
+    sign_in(page, engineer)
+    page.goto(f"{live_url}/cobots/{cobot.pk}/")
+
+    page.get_by_role("button", name="Power off").click()
+    page.get_by_role("dialog").get_by_role("button", name="Cancel").click()
+
+    expect(page.get_by_role("dialog")).to_be_hidden()
+    page.wait_for_timeout(500)
+    assert not CobotCommand.objects.exists()
+    expect(page.locator("#commands tbody")).to_contain_text("No commands yet.")
