@@ -45,6 +45,7 @@ from hrc.cases.models import Case, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
 from hrc.cobots import urua
+from hrc.cobots.control import running_commands
 from hrc.cobots.drivers.base import (
     CobotNotReady,
     CommandRefused,
@@ -141,11 +142,15 @@ def _lease_next(which: Q) -> Lease | None:
                 busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
                 paused=Exists(_unsettled_interruptions(cobot)),
                 held=Exists(_held_by_another_case(cobot.pk)),
+                # A person's command (power, program) is under way: no step meanwhile.
+                commanded=Exists(running_commands().filter(cobot=cobot)),
             )
-            .values_list("pk", "case_id", "busy", "paused", "held")[: settings.HRC_QUEUE_LOOKAHEAD]
+            .values_list("pk", "case_id", "busy", "paused", "held", "commanded")[
+                : settings.HRC_QUEUE_LOOKAHEAD
+            ]
         )  # fmt: skip
-        for job_id, case_id, busy, paused, held in list(queued):
-            if busy or paused:
+        for job_id, case_id, busy, paused, held, commanded in list(queued):
+            if busy or paused or commanded:
                 return None
             lease = _lease_if_ready(cobot, job_id, case_id, now, held=held)
             if lease is not None:

@@ -277,27 +277,6 @@ def interruptions_of(case: Case) -> QuerySet[Interruption]:
     )
 
 
-def cobot_in_use(cobot_id: int) -> str:
-    """Why a case is using the cobot right now, as a sentence; "" when none is.
-
-    A person's control command (hrc.cobots.control) is refused meanwhile. Call
-    while holding the cobot row lock, as a lease does, so no job starts between
-    this answer and the command's record.
-    """
-    job = (
-        Job.objects.filter(cobot_id=cobot_id, state=JobState.RUNNING)
-        .select_related("cobot", "case__version__pattern", "work_item")
-        .first()
-    )
-    if job is None:
-        return ""
-    task = job.work_item.label or job.work_item.task
-    return (
-        f"{job.cobot} is running {task} of case {job.case_id} "
-        f"({job.case.version.pattern.name}); wait until the step is done."
-    )
-
-
 def cobot_queue_lengths(cobot_ids: Iterable[int]) -> dict[int, int]:
     """How many jobs each cobot has queued or running, by cobot id (absent: none)."""
     counts = (

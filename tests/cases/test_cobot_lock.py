@@ -18,13 +18,15 @@ import pytest
 import redis
 from django.contrib.auth.models import User
 from django.db import connection, connections, transaction
+from django.utils import timezone
 
 from hrc.cases import jobs
 from hrc.cases.choices import JobState
 from hrc.cases.launcher import RedisProcess
 from hrc.cases.models import Job
 from hrc.celery import app
-from hrc.cobots.models import Cobot
+from hrc.cobots.choices import CommandOutcome, ControlCommand
+from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.models import Organisation
 from tests import factories
 
@@ -139,3 +141,19 @@ def test_a_finished_job_rings_for_the_cobots_next_job_only_when_one_is_queued(
     jobs.finish_job(second, {"outcome": "ran", "seconds": 0})
     assert doorbells.llen(queue) == 3  # nothing left to run on the cobot: no doorbell
     assert set(Job.objects.filter(cobot=cobot).values_list("state", flat=True)) == {JobState.SUCCEEDED}  # fmt: skip
+
+
+@pytest.mark.django_db(transaction=True)
+def test_no_job_is_leased_while_a_persons_command_to_the_cobot_is_under_way(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    cobot = _two_jobs_queued_on_one_cobot(organisation, engineer, operator)
+    command = CobotCommand.objects.create(
+        cobot=cobot, command=ControlCommand.LOAD_PROGRAM, requested_by=engineer
+    )
+
+    assert jobs.lease_next_job(cobot.pk) is None  # loading a program: no step meanwhile
+
+    command.outcome, command.finished_at = CommandOutcome.OK, timezone.now()
+    command.save()
+    assert jobs.lease_next_job(cobot.pk) is not None
