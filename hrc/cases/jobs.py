@@ -52,6 +52,7 @@ from hrc.cobots.drivers.base import (
     DriverError,
     Fence,
     StepCommand,
+    cannot_move,
 )
 from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
@@ -97,6 +98,12 @@ def run_next_job(job_id: int) -> None:
             result = _execute(lease, on_sent=hold.release)
         except DriverError as error:
             fail_job(lease, error)
+        except Exception as error:
+            # A fault of ours, not the cobot's answer: a person decides at once (the step's
+            # token keeps a retry exactly-once), instead of a job left running until the
+            # sweeper takes it back, again and again.
+            logger.exception("Job %s failed unexpectedly", lease.job_id)
+            fail_job(lease, DriverError(f"The worker failed unexpectedly: {error!r}."))
         else:
             finish_job(lease, result)
     finally:
@@ -277,12 +284,9 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     if ready(state):
         return
     loaded = str(state.get("CurrentProgram") or "")
-    if state.get("RobotMode") != urua.ROBOT_MODE_RUNNING:
-        raise CobotNotReady(
-            f"{driver.name} is in robot mode {state.get('RobotMode')!r}: power it on and release "
-            "the brakes at the cell; hrc does not do that by itself.",
-            state=state,
-        )
+    problem = cannot_move(driver.name, state, page=f"/cobots/{cobot_id}/")
+    if problem is not None:
+        raise problem
     # A STOP from a tablet may have paused the program since the lease: playing it
     # again here would undo the STOP.
     if Cobot.objects.filter(pk=cobot_id, stopped_at__isnull=False).exists():

@@ -8,8 +8,9 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
   - cobot tasks, either a program step
     `"step": {"program": "Coexistence_PickAndPlace", "number": 2, "workspace": 0, "poses": [[x, y, z, rx, ry, rz]]}`
     or a device call `"device": {"call": "part-detection.scan", "args": {}}`;
-    a cobot task with neither runs step 1 of its actor's program (the actor's
-    `"program"` key, else DEFAULT_PROGRAM);
+    a step's program may instead come from its actor's `"program"` key, and a
+    step without a number is step 1; a cobot task that names no program
+    either way is a `task-config` error, never run with a program nobody chose;
   - any task: `outputs` (`{"case key": "expression over result and data"}`;
     without it the whole result is stored under the task's id), `timeout`
     (seconds) and `retries` (automatic retries of a cobot or device task).
@@ -36,7 +37,6 @@ from hrc.engine.model import Pattern, Transition
 
 TaskKind = Literal["operator", "step", "device"]
 
-DEFAULT_PROGRAM: Final = "Coexistence_PickAndPlace"  # its step 1 moves home: harmless anywhere
 DEFAULT_TIMEOUT: Final = 120.0
 DEFAULT_RETRIES: Final = 3
 POSE_LENGTH: Final = 6
@@ -130,8 +130,9 @@ def task_config(pattern: Pattern, transition: Transition) -> TaskConfig:
         raise ConfigError(t, "a cobot task runs either a 'step' or a 'device' call, not both.")
     if "device" in raw:
         return TaskConfig("device", device=_device(t, raw["device"]), **common)
-    default_program = actor.extra.get("program", DEFAULT_PROGRAM)
-    return TaskConfig("step", step=_step(t, raw.get("step", {}), default_program), **common)
+    return TaskConfig(
+        "step", step=_step(t, raw.get("step", {}), actor.extra.get("program")), **common
+    )
 
 
 def _common(t: str, raw: Mapping[str, Any]) -> dict[str, Any]:
@@ -168,6 +169,10 @@ def _step(t: str, raw: object, default_program: object) -> StepConfig:
     if not isinstance(raw, Mapping):
         raise ConfigError(t, "'step' must be an object.")
     program = raw.get("program", default_program)
+    if program is None:
+        raise ConfigError(
+            t, "the cobot task names no program: give its step a 'program', or its actor one."
+        )
     if not isinstance(program, str) or not program:
         raise ConfigError(t, "the step's 'program' must be a program name.")
     number = raw.get("number", 1)

@@ -29,13 +29,19 @@ from hrc.cobots.choices import CommandOutcome, ControlCommand
 from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.models import Organisation
 from tests import factories
+from tests.cases.patterns import PROGRAM
 
 
 def _one_cobot_task() -> dict[str, Any]:
     """The cobot picks (its job queued as the case starts) while the operator loads the cell."""
     transitions = [
         {"id": "split"},
-        {"id": "tc1", "performer": "c", "label": "pick", "task": {"step": {"number": 3}}},
+        {
+            "id": "tc1",
+            "performer": "c",
+            "label": "pick",
+            "task": {"step": {"program": PROGRAM, "number": 3}},
+        },
         {"id": "to1", "performer": "o", "label": "load the cell"},
         {"id": "join"},
     ]

@@ -61,7 +61,15 @@ def document(
     data: dict[str, Any] = {
         "format": "hrc-pattern/1",
         "name": "test",
-        "actors": [{"id": a, "type": t} for a, t in actors.items()],
+        # A cobot's program: a cobot task that names none is a task-config error.
+        "actors": [
+            {
+                "id": a,
+                "type": t,
+                **({"program": "Coexistence_PickAndPlace"} if t == "cobot" else {}),
+            }
+            for a, t in actors.items()
+        ],
         "processes": list(processes),
         "constraints": [{"from": a, "to": b, "type": t} for a, b, t in constraints],
     }

@@ -7,7 +7,6 @@ import pytest
 from hrc.engine import check_document, read_pattern
 from hrc.engine.runtime import CaseNet, resolve
 from hrc.engine.taskconfig import (
-    DEFAULT_PROGRAM,
     DEFAULT_RETRIES,
     DEFAULT_TIMEOUT,
     DEVICE_CALLS,
@@ -64,13 +63,24 @@ def _refused(task: object, task_id: str = "tc1") -> str:
 # Defaults -------------------------------------------------------------------------
 
 
-def test_a_cobot_task_without_config_runs_step_1_of_the_default_program() -> None:
+def test_a_cobot_task_that_names_no_program_is_refused_not_run_with_a_default() -> None:
+    data = _doc()
+    del data["actors"][0]["program"]
+
+    with pytest.raises(ConfigError, match=r"^tc1: the cobot task names no program"):
+        _config("tc1", data)
+    assert [(i.code, i.elements) for i in config_issues(read_pattern(data))] == [
+        ("task-config", ("tc1",))
+    ]
+
+
+def test_a_cobot_task_without_config_runs_step_1_of_its_actors_program_with_the_defaults() -> None:
     config = _config("tc1", _doc())
 
     assert config.kind == "step"
     assert config.step is not None
     assert (config.step.program, config.step.number, config.step.workspace) == (
-        DEFAULT_PROGRAM,
+        "Coexistence_PickAndPlace",
         1,
         0,
     )

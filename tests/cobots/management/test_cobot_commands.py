@@ -42,7 +42,7 @@ def test_cobot_step_reports_a_protective_stop_clearly(
     gateway: GatewayProcess, driver: OpcUaDriver
 ) -> None:
     run("cobot_fault", "cobot1", "--endpoint", gateway.endpoint, "protective-stop")
-    with pytest.raises(CommandError, match=r"PROTECTIVE_STOP.*a person must clear it"):
+    with pytest.raises(CommandError, match=r"protective stop.*a person must check the cell"):
         run("cobot_step", "cobot1", "--endpoint", gateway.endpoint, "--step", "1")
 
 

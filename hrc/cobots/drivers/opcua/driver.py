@@ -41,6 +41,7 @@ from hrc.cobots.drivers.base import (
     StepCommand,
     StepResult,
     StepTimeout,
+    cannot_move,
 )
 from hrc.cobots.pki import PkiError, check_gateway_certificate, secure_client
 
@@ -439,21 +440,10 @@ class OpcUaDriver(CobotDriver):
 
     def _unready(self, fence: Any) -> DriverError | None:
         """Why the cached state says the cobot cannot take a step now; None when it can."""
-        mode = self.cache[urua.STATE_ROBOT_MODE]
-        safety = self.cache[urua.STATE_SAFETY_MODE]
         program = self.cache[urua.STATE_PROGRAM_STATE]
-        if safety not in urua.SAFETY_MODES_THAT_MOVE:
-            return CobotStopped(
-                f"{self.name} is in {safety}: a person must clear it at the cell; "
-                f"step {fence} was not sent.",
-                state=self.cache,
-            )
-        if mode != urua.ROBOT_MODE_RUNNING:
-            return CobotNotReady(
-                f"{self.name} is in robot mode {mode!r}, not Running: power it on "
-                f"(PowerOn) first; step {fence} was not sent.",
-                state=self.cache,
-            )
+        problem = cannot_move(self.name, self._state_from_cache())
+        if problem is not None:
+            return type(problem)(f"{problem} Step {fence} was not sent.", state=problem.state)
         if program != urua.PROGRAM_PLAYING:
             return CobotNotReady(
                 f"{self.name}'s program is {program!r}, not Playing: select and start the step "

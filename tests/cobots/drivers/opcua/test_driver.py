@@ -121,7 +121,7 @@ async def test_a_protective_stop_refuses_a_step_without_sending_it(
 ) -> None:
     await driver.call("Simulator/InjectFault", "protective-stop", "")
     await until(lambda: driver.cache[urua.STATE_SAFETY_MODE] != urua.SAFETY_NORMAL)
-    with pytest.raises(CobotStopped, match="PROTECTIVE_STOP") as stopped:
+    with pytest.raises(CobotStopped, match="protective stop") as stopped:
         await driver.run_step(StepCommand(step=HOME, fence=Fence(12, 1)))
     assert not stopped.value.transient
     assert await read(observer, urua.register_path("Inputs", "Bit64")) is False
