@@ -21,7 +21,7 @@ from django.core.management import call_command
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 from django.db import OperationalError
 
-from hrc.demo import library, organisation
+from hrc.demo import library, organisation, plant
 from hrc.demo.organisation import DEMO_COBOTS, PERSONAS
 from hrc.demo.runner import Demo, DemoFailed, Plan
 
@@ -68,6 +68,11 @@ class Command(BaseCommand):
         parser.add_argument(
             "--logs", type=Path, default=settings.VAR_DIR / "demo", help="Folder for the logs."
         )
+        parser.add_argument(
+            "--no-cases",
+            action="store_true",
+            help="Start no use-case cases (by default a few start, so the tablets have work).",
+        )
 
     def handle(self, *args: Any, **options: Any) -> None:
         plan = Plan(
@@ -101,7 +106,10 @@ class Command(BaseCommand):
         failure: DemoFailed | None = None
         try:
             demo.start(self.say)
-            self.banner(plan, demo_organisation)
+            self.say("Powering the cobots on and releasing their brakes, as at the pendant")
+            cobots = plant.prepare_cobots({c.name: c.endpoint for c in demo_organisation.cobots})
+            cases = [] if options["no_cases"] else self.start_cases(plan, demo_organisation)
+            self.banner(plan, demo_organisation, cobots, cases)
             demo.serve(stop=lambda: False)
         except KeyboardInterrupt:
             self.say("Stopping the demo")
@@ -135,7 +143,17 @@ class Command(BaseCommand):
         self.say(f"{demo.organisation.name}: {published} example patterns published")
         return demo
 
-    def banner(self, plan: Plan, demo: organisation.DemoOrganisation) -> None:
+    def start_cases(self, plan: Plan, demo: organisation.DemoOrganisation) -> list[str]:
+        folder = library.EXAMPLES_DIR / library.USE_CASES
+        return plant.start_cases(plan.url, demo.users["engineer"], demo.organisation, folder)
+
+    def banner(
+        self,
+        plan: Plan,
+        demo: organisation.DemoOrganisation,
+        cobots: list[str],
+        cases: list[str],
+    ) -> None:
         url = plan.url
         lines = ["", self.style.SUCCESS(f"{demo.organisation.name} at {url}/accounts/login/")]
         lines += organisation.credential_lines(demo)
@@ -145,10 +163,13 @@ class Command(BaseCommand):
             lines.append(f"  {persona.username:<10} {pages}")
         lines += ["Pages:"]
         lines += [f"  {name:<10} {url}{path:<12} {who}" for name, path, who in PAGES]
-        cobots = ", ".join(
+        endpoints = ", ".join(
             f"{c.name} opc.tcp://127.0.0.1:{plan.cobot_ports[c.name]}" for c in demo.cobots
         )
-        lines.append(f"Simulated cobots: {cobots}")
+        lines.append(f"Simulated cobots: {endpoints}")
+        lines += cobots
+        if cases:
+            lines += ["Cases started (operators: take their tasks on the tablet):", *cases]
         if plan.redis:
             lines.append("Jobs: a Celery worker with beat, and the cobot monitor, on REDIS_URL")
         else:
