@@ -26,25 +26,40 @@ from urllib.parse import urlsplit, urlunsplit
 from hrc.cobots.gateway.launcher import ROOT, free_port
 from hrc.patterns.management.commands.demo import SERVING
 
+# What the test run's environment says that a person's shell would not.
+OURS = ("DATABASE_URL", "REDIS_URL", "HRC_CELERY_QUEUE", "HRC_VAR_DIR")
 PASSWORD_LINE = re.compile(r"^\s+(\S+)\s+password (\S+)\s", re.MULTILINE)
+CASE_LINE = re.compile(r"^\s+(.+?) on \S+: case (\d+)\s", re.MULTILINE)
 START_TIMEOUT = 240.0
 
 
 class DemoRun:
-    def __init__(self, workdir: Path, *, database_url: str, redis_url: str | None = None) -> None:
+    def __init__(
+        self,
+        workdir: Path,
+        *,
+        database_url: str | None,
+        redis_url: str | None = None,
+        via_make: bool = False,
+    ) -> None:
+        """`database_url` None: the embedded default, under a var/ of the workdir's own;
+        `via_make`: `make demo`, as the README says, instead of `manage.py demo`."""
         self.workdir = workdir
+        self.via_make = via_make
         self.port = free_port()
         self.cobot_ports = {"cobot1": free_port(), "cobot2": free_port()}
         self.logs = workdir / "logs"
         self.out = workdir / "demo.out"
         self.environment = {
-            **{k: v for k, v in os.environ.items() if k not in ("REDIS_URL", "HRC_CELERY_QUEUE")},
+            **{k: v for k, v in os.environ.items() if k not in OURS},
             "DJANGO_SETTINGS_MODULE": "hrc.settings.dev",
-            "DATABASE_URL": database_url,
+            "HRC_VAR_DIR": str(workdir / "var"),
             "HRC_SIM_STATE_DIR": str(workdir / "cobots"),
             "HRC_PKI_DIR": str(workdir / "pki"),
             "PYTHONUNBUFFERED": "1",
         }
+        if database_url is not None:
+            self.environment["DATABASE_URL"] = database_url
         if redis_url is not None:
             self.environment["REDIS_URL"] = redis_url
         self.process: subprocess.Popen[bytes] | None = None
@@ -56,14 +71,19 @@ class DemoRun:
     def start(self, timeout: float = START_TIMEOUT) -> Self:
         """Starts the demo and returns once it prints the line that says it serves."""
         ports = ",".join(str(port) for port in self.cobot_ports.values())
-        command = [
-            sys.executable, "manage.py", "demo", "--port", str(self.port), "--cobot-ports", ports,
-            "--time-scale", "0.05", "--logs", str(self.logs),
+        options = [
+            "--port", str(self.port), "--cobot-ports", ports, "--time-scale", "0.05",
+            "--logs", str(self.logs),
         ]  # fmt: skip
+        command = [sys.executable, "manage.py", "demo", *options]
+        if self.via_make:
+            command = ["make", "--no-print-directory", "demo", f"DEMO_ARGS={' '.join(options)}"]
         with self.out.open("wb") as out:
+            # Under make, its own session: a Ctrl-C at a terminal reaches make and the demo both.
             self.process = subprocess.Popen(
-                command, cwd=ROOT, env=self.environment, stdout=out, stderr=subprocess.STDOUT
-            )
+                command, cwd=ROOT, env=self.environment, stdout=out, stderr=subprocess.STDOUT,
+                start_new_session=self.via_make,
+            )  # fmt: skip
         deadline = time.monotonic() + timeout
         while SERVING not in self.output():
             if self.process.poll() is not None or time.monotonic() > deadline:
@@ -78,6 +98,10 @@ class DemoRun:
     def passwords(self) -> dict[str, str]:
         """User name → password, as the demo printed them."""
         return dict(PASSWORD_LINE.findall(self.output()))
+
+    def started_cases(self) -> dict[str, int]:
+        """Use case name → the id of the case the demo started of it, as the banner said."""
+        return {name: int(case) for name, case in CASE_LINE.findall(self.output())}
 
     def descendants(self) -> dict[int, str]:
         """Every process below the demo's (pid → command line), from /proc."""
@@ -98,15 +122,23 @@ class DemoRun:
         return found
 
     def signal(self, signum: int, timeout: float = 60.0) -> int:
-        """Sends `signum` to the demo's process only (not its group); returns its exit code."""
+        """Sends `signum` to the demo's process only (under make: to make and the demo, as a
+        terminal does); returns its exit code."""
+        self._send(signum)
         assert self.process is not None
-        self.process.send_signal(signum)
         return self.process.wait(timeout)
+
+    def _send(self, signum: int) -> None:
+        assert self.process is not None
+        if self.via_make:
+            os.killpg(self.process.pid, signum)
+        else:
+            self.process.send_signal(signum)
 
     def stop(self) -> None:
         """The clean-up of a test that failed half-way: SIGTERM, then SIGKILL."""
         if self.process is not None and self.process.poll() is None:
-            self.process.send_signal(signal.SIGTERM)
+            self._send(signal.SIGTERM)
             try:
                 self.process.wait(60)
             except subprocess.TimeoutExpired:

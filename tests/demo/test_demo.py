@@ -47,6 +47,12 @@ def test_on_embedded_defaults_it_serves_every_persona_and_ctrl_c_ends_every_proc
     try:
         assert "SQLite" in demo.output()
         assert "embedded mode" in demo.output()
+        for cobot in ("cobot1", "cobot2"):  # as a person at the pendant would, once serving
+            assert f"{cobot}: powered on and brakes released" in demo.output()
+        assert sorted(demo.started_cases()) == [
+            "Use case 3: pick & place (1 operator, 1 cobot)",
+            "Use case 5: polishing (1 operator, 1 cobot)",
+        ]
         _check_personas(demo)
         # The monitor runs inside the web server: its states reach a tablet over the in-memory layer.
         assert asyncio.run(_reachable_cobots(demo, "operator1")) == {"cobot1", "cobot2"}
