@@ -16,7 +16,7 @@ import json
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -78,7 +78,7 @@ def prepare_cobots(
     return preparations
 
 
-def _wait_running(state: Any, timeout: float) -> str:
+def _wait_running(state: Callable[[], Mapping[str, Any]], timeout: float) -> str:
     """The cobot's RobotMode once it is Running, or the last one seen after `timeout` seconds."""
     deadline = time.monotonic() + timeout
     mode = str(state()["RobotMode"])
