@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import contextlib
 import http.cookiejar
-import json
 import os
 import re
 import shlex
@@ -25,7 +24,7 @@ import urllib.parse
 import urllib.request
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any, Self
+from typing import Self
 from urllib.parse import urlsplit, urlunsplit
 
 from hrc.cobots.gateway.launcher import ROOT, free_port
@@ -111,21 +110,6 @@ class DemoRun:
     def started_cases(self) -> dict[str, int]:
         """Pattern name → id of each case the banner says the demo started."""
         return {name: int(case) for name, case in STARTED_LINE.findall(self.output())}
-
-    def api(self, username: str, path: str) -> Any:
-        """GET `path` of the REST API as `username`, with a token from the printed password."""
-        body = json.dumps({"username": username, "password": self.passwords()[username]})
-        request = urllib.request.Request(
-            f"{self.url}/api/token/", data=body.encode(),
-            headers={"Content-Type": "application/json"},
-        )  # fmt: skip
-        with urllib.request.urlopen(request, timeout=30) as response:
-            token = json.load(response)["token"]
-        request = urllib.request.Request(
-            f"{self.url}{path}", headers={"Authorization": f"Token {token}"}
-        )
-        with urllib.request.urlopen(request, timeout=30) as response:
-            return json.load(response)
 
     def descendants(self) -> dict[int, str]:
         """Every process below the demo's (pid → command line), from /proc."""
