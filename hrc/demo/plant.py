@@ -69,7 +69,9 @@ def prepare_cobots(
             driver.call("PowerOn", timeout=timeout)
             mode = _wait_running(driver.state, timeout)
         except DriverError as error:
-            preparations.append(Preparation(name, f"{error} {_remedy(name)}"))
+            # The driver's message starts with the cobot's name, which the banner says already.
+            message = str(error).removeprefix(f"{name}: ")
+            preparations.append(Preparation(name, f"{message} {_remedy(name)}"))
             continue
         finally:
             driver.close()
@@ -90,9 +92,8 @@ def _wait_running(state: Callable[[], Mapping[str, Any]], timeout: float) -> str
 
 def _remedy(name: str) -> str:
     return (
-        f"A person checks the cell and clears any stop at the pendant (in the simulator: "
-        f"manage.py cobot_call {name} Simulator/UnlockProtectiveStop), then powers it on from "
-        f"its page under /cobots/ or with manage.py cobot_call {name} PowerOn."
+        f"In the demo, as that person: manage.py cobot_fault {name} unlock, then power it on "
+        f"from its page under /cobots/ or with manage.py cobot_call {name} PowerOn."
     )
 
 

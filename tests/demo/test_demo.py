@@ -131,7 +131,8 @@ def test_a_cobot_left_in_a_protective_stop_is_named_with_what_to_do_and_stays_st
         named = re.search(r"^cobot1: not prepared: (.*)$", output, re.MULTILINE)
         assert named is not None, output
         assert "PROTECTIVE_STOP" in named.group(1)
-        assert "Simulator/UnlockProtectiveStop" in named.group(1)
+        assert named.group(1).startswith("PowerOn refused")
+        assert "cobot_fault cobot1 unlock" in named.group(1)
         assert "cobot_call cobot1 PowerOn" in named.group(1)
         # Nothing cleared the stop or powered the arm on; the demo serves all the same.
         states = _cobot_states(demo)
