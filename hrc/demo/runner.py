@@ -4,7 +4,7 @@ Each child gets a session (process group) of its own, so Ctrl-C at the
 terminal reaches only the runner, which then stops the children itself: the
 web server first, the gateways last, each with SIGTERM to its whole group
 (a Celery worker's pool children included) and SIGKILL after a grace
-period. On Linux each child is also asked to die with the runner
+period. On Linux each child is also killed with the runner
 (PR_SET_PDEATHSIG), so a runner killed outright leaves no orphans either.
 """
 
@@ -228,7 +228,14 @@ def _free(host: str, port: int) -> bool:
 
 
 def _die_with_parent() -> None:
-    """In the child before exec: SIGTERM when the runner dies (Linux; elsewhere a no-op)."""
+    """In the child before exec: SIGKILL when the runner dies (Linux; elsewhere a no-op).
+
+    SIGKILL, not SIGTERM: with a case's step in flight a gateway and the web
+    server that all get SIGTERM at once wait on each other's goodbye, and a
+    dead runner cannot follow up with SIGKILL as its own stop does. Every
+    simulator change is saved as it happens, and a job cut short is taken
+    back by the sweeper on the next start.
+    """
     if sys.platform.startswith("linux"):
         libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)

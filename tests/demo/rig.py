@@ -1,9 +1,12 @@
 """`manage.py demo` as a person runs it: a subprocess with its own database, ports and logs.
 
-The demo test and the personas' browser test both drive it. It runs the
-project's dev settings, as `make demo` does; the database is SQLite in a
-temporary folder or a scratch PostgreSQL database, and Redis, when given, a
-private redis-server, so nothing is shared with the test run or anyone else.
+The demo test and the browser tests both drive it. It runs the project's
+dev settings, as `make demo` does; the database is SQLite in a temporary
+folder or a scratch PostgreSQL database, and Redis, when given, a private
+redis-server, so nothing is shared with the test run or anyone else.
+`make=True` runs `make demo DEMO_ARGS=…` from the project root as a newcomer
+does, with no DATABASE_URL (None: the embedded SQLite under HRC_VAR_DIR) and
+Ctrl-C going to the whole foreground process group, as at a terminal.
 """
 
 from __future__ import annotations
@@ -12,13 +15,14 @@ import contextlib
 import http.cookiejar
 import os
 import re
+import shlex
 import signal
 import subprocess
 import sys
 import time
 import urllib.parse
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Self
 from urllib.parse import urlsplit, urlunsplit
@@ -26,10 +30,8 @@ from urllib.parse import urlsplit, urlunsplit
 from hrc.cobots.gateway.launcher import ROOT, free_port
 from hrc.patterns.management.commands.demo import SERVING
 
-# What the test run's environment says that a person's shell would not.
-OURS = ("DATABASE_URL", "REDIS_URL", "HRC_CELERY_QUEUE", "HRC_VAR_DIR")
 PASSWORD_LINE = re.compile(r"^\s+(\S+)\s+password (\S+)\s", re.MULTILINE)
-CASE_LINE = re.compile(r"^\s+(.+?) on \S+: case (\d+)\s", re.MULTILINE)
+STARTED_LINE = re.compile(r"^\s+(.+): case (\d+)\s+http", re.MULTILINE)
 START_TIMEOUT = 240.0
 
 
@@ -40,29 +42,32 @@ class DemoRun:
         *,
         database_url: str | None,
         redis_url: str | None = None,
-        via_make: bool = False,
+        make: bool = False,
+        arguments: Sequence[str] = (),
     ) -> None:
-        """`database_url` None: the embedded default, under a var/ of the workdir's own;
-        `via_make`: `make demo`, as the README says, instead of `manage.py demo`."""
         self.workdir = workdir
-        self.via_make = via_make
         self.port = free_port()
         self.cobot_ports = {"cobot1": free_port(), "cobot2": free_port()}
         self.logs = workdir / "logs"
         self.out = workdir / "demo.out"
+        self.make = make
+        self.arguments = list(arguments)
+        unset = ("DATABASE_URL", "REDIS_URL", "HRC_CELERY_QUEUE", "DJANGO_SETTINGS_MODULE")
         self.environment = {
-            **{k: v for k, v in os.environ.items() if k not in OURS},
-            "DJANGO_SETTINGS_MODULE": "hrc.settings.dev",
+            **{k: v for k, v in os.environ.items() if k not in unset},
             "HRC_VAR_DIR": str(workdir / "var"),
             "HRC_SIM_STATE_DIR": str(workdir / "cobots"),
             "HRC_PKI_DIR": str(workdir / "pki"),
             "PYTHONUNBUFFERED": "1",
         }
+        if not make:  # manage.py's own default is the dev settings too; said here as before
+            self.environment["DJANGO_SETTINGS_MODULE"] = "hrc.settings.dev"
         if database_url is not None:
             self.environment["DATABASE_URL"] = database_url
         if redis_url is not None:
             self.environment["REDIS_URL"] = redis_url
         self.process: subprocess.Popen[bytes] | None = None
+        self.started_in: float | None = None
 
     @property
     def url(self) -> str:
@@ -71,25 +76,28 @@ class DemoRun:
     def start(self, timeout: float = START_TIMEOUT) -> Self:
         """Starts the demo and returns once it prints the line that says it serves."""
         ports = ",".join(str(port) for port in self.cobot_ports.values())
-        options = [
+        arguments = [
             "--port", str(self.port), "--cobot-ports", ports, "--time-scale", "0.05",
-            "--logs", str(self.logs),
+            "--logs", str(self.logs), *self.arguments,
         ]  # fmt: skip
-        command = [sys.executable, "manage.py", "demo", *options]
-        if self.via_make:
-            command = ["make", "--no-print-directory", "demo", f"DEMO_ARGS={' '.join(options)}"]
+        if self.make:
+            command = ["make", "--no-print-directory", "demo", f"DEMO_ARGS={shlex.join(arguments)}"]
+        else:
+            command = [sys.executable, "manage.py", "demo", *arguments]
+        began = time.monotonic()
         with self.out.open("wb") as out:
-            # Under make, its own session: a Ctrl-C at a terminal reaches make and the demo both.
+            # make runs in a session of its own: its group is what a terminal's Ctrl-C reaches.
             self.process = subprocess.Popen(
                 command, cwd=ROOT, env=self.environment, stdout=out, stderr=subprocess.STDOUT,
-                start_new_session=self.via_make,
+                start_new_session=self.make,
             )  # fmt: skip
-        deadline = time.monotonic() + timeout
+        deadline = began + timeout
         while SERVING not in self.output():
             if self.process.poll() is not None or time.monotonic() > deadline:
                 self.stop()
                 raise RuntimeError(f"The demo did not start:\n{self.output()}")
             time.sleep(0.2)
+        self.started_in = time.monotonic() - began
         return self
 
     def output(self) -> str:
@@ -100,8 +108,8 @@ class DemoRun:
         return dict(PASSWORD_LINE.findall(self.output()))
 
     def started_cases(self) -> dict[str, int]:
-        """Use case name → the id of the case the demo started of it, as the banner said."""
-        return {name: int(case) for name, case in CASE_LINE.findall(self.output())}
+        """Pattern name → id of each case the banner says the demo started."""
+        return {name: int(case) for name, case in STARTED_LINE.findall(self.output())}
 
     def descendants(self) -> dict[int, str]:
         """Every process below the demo's (pid → command line), from /proc."""
@@ -122,15 +130,15 @@ class DemoRun:
         return found
 
     def signal(self, signum: int, timeout: float = 60.0) -> int:
-        """Sends `signum` to the demo's process only (under make: to make and the demo, as a
-        terminal does); returns its exit code."""
-        self._send(signum)
+        """Sends `signum` to the demo's process only, or under make to make's whole group (as a
+        terminal's Ctrl-C does); returns the exit code of the process started."""
         assert self.process is not None
+        self._send(signum)
         return self.process.wait(timeout)
 
     def _send(self, signum: int) -> None:
         assert self.process is not None
-        if self.via_make:
+        if self.make:
             os.killpg(self.process.pid, signum)
         else:
             self.process.send_signal(signum)
@@ -138,10 +146,14 @@ class DemoRun:
     def stop(self) -> None:
         """The clean-up of a test that failed half-way: SIGTERM, then SIGKILL."""
         if self.process is not None and self.process.poll() is None:
-            self._send(signal.SIGTERM)
+            with contextlib.suppress(ProcessLookupError):
+                self._send(signal.SIGTERM)
             try:
                 self.process.wait(60)
             except subprocess.TimeoutExpired:
+                if self.make:
+                    with contextlib.suppress(ProcessLookupError):
+                        os.killpg(self.process.pid, signal.SIGKILL)
                 self.process.kill()
                 self.process.wait()
 

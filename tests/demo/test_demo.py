@@ -26,8 +26,12 @@ import pytest
 from websockets.asyncio.client import connect
 
 from hrc.cases.launcher import RedisProcess
+from hrc.cobots import urua
+from hrc.cobots.drivers.runner import driver_for
 from hrc.cobots.gateway.launcher import ROOT, free_port
 from hrc.demo.organisation import PERSONAS
+from hrc.demo.plant import STARTED_CASES
+from hrc.patterns.management.commands.demo import PREPARED
 from tests.demo.rig import Browserless, DemoRun, alive, scratch_postgres
 
 CONFIG = re.compile(r'<script id="tablet-config" type="application/json">(.*?)</script>', re.S)
@@ -47,12 +51,12 @@ def test_on_embedded_defaults_it_serves_every_persona_and_ctrl_c_ends_every_proc
     try:
         assert "SQLite" in demo.output()
         assert "embedded mode" in demo.output()
-        for cobot in ("cobot1", "cobot2"):  # as a person at the pendant would, once serving
-            assert f"{cobot}: powered on and brakes released" in demo.output()
-        assert sorted(demo.started_cases()) == [
-            "Use case 3: pick & place (1 operator, 1 cobot)",
-            "Use case 5: polishing (1 operator, 1 cobot)",
-        ]
+        assert f"cobot1, cobot2: {PREPARED}" in demo.output()
+        assert _cobot_states(demo) == {"cobot1": RUNNING_NORMAL, "cobot2": RUNNING_NORMAL}
+        started = demo.started_cases()
+        assert set(started) == {pattern for pattern, _ in STARTED_CASES}
+        for case in started.values():
+            assert f"{demo.url}/cases/{case}/" in demo.output()
         _check_personas(demo)
         # The monitor runs inside the web server: its states reach a tablet over the in-memory layer.
         assert asyncio.run(_reachable_cobots(demo, "operator1")) == {"cobot1", "cobot2"}
@@ -73,10 +77,20 @@ def test_with_database_and_redis_urls_it_runs_a_worker_and_the_monitor_and_sigte
     tmp_path: Path, redis_url: str
 ) -> None:
     with scratch_postgres(f"hrc_demo_{os.getpid()}") as database_url:
-        demo = DemoRun(tmp_path, database_url=database_url, redis_url=redis_url).start()
+        demo = DemoRun(
+            tmp_path, database_url=database_url, redis_url=redis_url, arguments=["--no-cases"]
+        ).start()
         try:
             assert "PostgreSQL hrc_demo_" in demo.output()
             assert "a Celery worker with beat" in demo.output()
+            assert f"cobot1, cobot2: {PREPARED}" in demo.output()
+            assert _cobot_states(demo) == {"cobot1": RUNNING_NORMAL, "cobot2": RUNNING_NORMAL}
+            assert "Cases: none started (--no-cases)" in demo.output()
+            assert demo.started_cases() == {}
+            engineer = Browserless(demo.url)
+            assert engineer.sign_in("engineer", demo.passwords()["engineer"])
+            status, _, body = engineer.get("/api/cases/")
+            assert (status, json.loads(body)["count"]) == (200, 0)
             _check_personas(demo)
             assert asyncio.run(_reachable_cobots(demo, "operator2")) == {"cobot1", "cobot2"}
             children = demo.descendants()
@@ -90,6 +104,44 @@ def test_with_database_and_redis_urls_it_runs_a_worker_and_the_monitor_and_sigte
         finally:
             demo.stop()
     _check_everything_ended(demo, children)
+
+
+def test_a_cobot_left_in_a_protective_stop_is_named_with_what_to_do_and_stays_stopped(
+    tmp_path: Path,
+) -> None:
+    """An earlier run's protective stop is saved in the simulator's state: the software keeps it."""
+    database_url = f"sqlite:///{tmp_path / 'demo.sqlite3'}"
+    earlier = DemoRun(tmp_path, database_url=database_url, arguments=["--no-cases"]).start()
+    try:
+        fault = subprocess.run(
+            [sys.executable, "manage.py", "cobot_fault", "cobot1", "protective-stop",
+             "--endpoint", f"opc.tcp://127.0.0.1:{earlier.cobot_ports['cobot1']}"],
+            cwd=ROOT, env=earlier.environment, capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        assert fault.returncode == 0, fault.stderr
+        assert earlier.signal(signal.SIGINT) == 0
+    finally:
+        earlier.stop()
+
+    demo = DemoRun(tmp_path, database_url=database_url).start()
+    try:
+        output = demo.output()
+        assert f"cobot2: {PREPARED}" in output
+        assert f"cobot1, cobot2: {PREPARED}" not in output
+        named = re.search(r"^cobot1: not prepared: (.*)$", output, re.MULTILINE)
+        assert named is not None, output
+        assert "PROTECTIVE_STOP" in named.group(1)
+        assert named.group(1).startswith("PowerOn refused")
+        assert "cobot_fault cobot1 unlock" in named.group(1)
+        assert "cobot_call cobot1 PowerOn" in named.group(1)
+        # Nothing cleared the stop or powered the arm on; the demo serves all the same.
+        states = _cobot_states(demo)
+        assert states["cobot1"][1] == "SAFETY_MODE_PROTECTIVE_STOP"
+        assert states["cobot2"] == RUNNING_NORMAL
+        assert Browserless(demo.url).sign_in("operator1", demo.passwords()["operator1"])
+        assert demo.signal(signal.SIGINT) == 0
+    finally:
+        demo.stop()
 
 
 def test_a_demo_killed_outright_takes_its_processes_with_it(tmp_path: Path) -> None:
@@ -157,6 +209,22 @@ def test_a_database_or_redis_that_does_not_answer_is_named_and_nothing_is_starte
     assert message in result.stderr
     assert "Traceback" not in result.stderr
     assert not (tmp_path / "logs").exists()
+
+
+RUNNING_NORMAL = (urua.ROBOT_MODE_RUNNING, urua.SAFETY_NORMAL)
+
+
+def _cobot_states(demo: DemoRun) -> dict[str, tuple[str, str]]:
+    """(RobotMode, SafetyMode) of each demo cobot, read from its gateway by this test."""
+    states = {}
+    for name, port in demo.cobot_ports.items():
+        driver = driver_for(name, f"opc.tcp://127.0.0.1:{port}")
+        try:
+            state = driver.state()
+        finally:
+            driver.close()
+        states[name] = (str(state["RobotMode"]), str(state["SafetyMode"]))
+    return states
 
 
 def _check_personas(demo: DemoRun) -> None:

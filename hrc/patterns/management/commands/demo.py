@@ -6,6 +6,9 @@ server (hrc.embedded); with it, a Celery worker with beat and `live_cobots`
 run beside it. DATABASE_URL chooses the database as everywhere (SQLite under
 var/ when unset). The personas' passwords are generated on every run and
 printed once, at the end of start-up; --keep-passwords leaves existing ones.
+Once everything serves, the demo prepares its simulated cobots as a person
+at the pendant would and starts a few use cases through the server
+(hrc.demo.plant), unless --no-cases.
 """
 
 from __future__ import annotations
@@ -27,6 +30,11 @@ from hrc.demo.runner import Demo, DemoFailed, Plan
 
 # The line scripts and tests wait for: everything is up once it is printed.
 SERVING = "hrc demo serving"
+# What the banner says of each cobot the demo powered on.
+PREPARED = (
+    "powered on and brakes released, as a person at the pendant would; hrc loads each step's "
+    "program"
+)
 # (page, path, who uses it) for the start-up banner.
 PAGES = (
     ("tablet", "/tablet/", "operators"),
@@ -66,12 +74,12 @@ class Command(BaseCommand):
             help="Leave the passwords of demo users who have one (they are not printed).",
         )
         parser.add_argument(
-            "--logs", type=Path, default=settings.VAR_DIR / "demo", help="Folder for the logs."
-        )
-        parser.add_argument(
             "--no-cases",
             action="store_true",
-            help="Start no use-case cases (by default a few start, so the tablets have work).",
+            help="Start no use-case cases (the cobots are still powered on).",
+        )
+        parser.add_argument(
+            "--logs", type=Path, default=settings.VAR_DIR / "demo", help="Folder for the logs."
         )
 
     def handle(self, *args: Any, **options: Any) -> None:
@@ -106,10 +114,9 @@ class Command(BaseCommand):
         failure: DemoFailed | None = None
         try:
             demo.start(self.say)
-            self.say("Powering the cobots on and releasing their brakes, as at the pendant")
-            cobots = plant.prepare_cobots({c.name: c.endpoint for c in demo_organisation.cobots})
-            cases = [] if options["no_cases"] else self.start_cases(plan, demo_organisation)
-            self.banner(plan, demo_organisation, cobots, cases)
+            preparations = self.prepare(plan)
+            started = self.start_cases(plan, demo_organisation, options["no_cases"])
+            self.banner(plan, demo_organisation, preparations, started)
             demo.serve(stop=lambda: False)
         except KeyboardInterrupt:
             self.say("Stopping the demo")
@@ -143,33 +150,64 @@ class Command(BaseCommand):
         self.say(f"{demo.organisation.name}: {published} example patterns published")
         return demo
 
-    def start_cases(self, plan: Plan, demo: organisation.DemoOrganisation) -> list[str]:
-        folder = library.EXAMPLES_DIR / library.USE_CASES
-        return plant.start_cases(plan.url, demo.users["engineer"], demo.organisation, folder)
+    def prepare(self, plan: Plan) -> list[plant.Preparation]:
+        self.say("Powering the simulated cobots on and releasing their brakes")
+        endpoints = {
+            cobot.name: cobot.endpoint(port=plan.cobot_ports[cobot.name]) for cobot in DEMO_COBOTS
+        }
+        return plant.prepare_cobots(endpoints)
+
+    def start_cases(
+        self, plan: Plan, demo: organisation.DemoOrganisation, no_cases: bool
+    ) -> list[str]:
+        """Starts the use cases through the server; returns the banner's lines about them."""
+        if no_cases:
+            return ["Cases: none started (--no-cases); start one from a pattern in the editor"]
+        password = demo.passwords["engineer"]
+        if password is None:
+            return [
+                "Cases: none started: the engineer kept their password (--keep-passwords), "
+                "which the demo does not know; start one from a pattern in the editor"
+            ]
+        cobot_ids = {cobot.name: cobot.pk for cobot in demo.cobots}
+        try:
+            started = plant.start_cases(plan.url, "engineer", password, cobot_ids)
+        except plant.CasesNotStarted as error:
+            self.stderr.write(f"The use cases did not start: {error}")
+            return [f"Cases: none started ({error}); start one from a pattern in the editor"]
+        lines = ["Cases started by engineer, for the operators' tablets and the cobots:"]
+        lines += [f"  {c.pattern}: case {c.case}  {plan.url}/cases/{c.case}/" for c in started]
+        return lines
 
     def banner(
         self,
         plan: Plan,
         demo: organisation.DemoOrganisation,
-        cobots: list[str],
+        preparations: list[plant.Preparation],
         cases: list[str],
     ) -> None:
         url = plan.url
         lines = ["", self.style.SUCCESS(f"{demo.organisation.name} at {url}/accounts/login/")]
         lines += organisation.credential_lines(demo)
-        lines += ["Where each persona works:"]
+        lines += ["Where each persona begins:"]
         for persona in PERSONAS:
             pages = "  ".join(f"{url}{path}" for path in persona.pages)
             lines.append(f"  {persona.username:<10} {pages}")
         lines += ["Pages:"]
         lines += [f"  {name:<10} {url}{path:<12} {who}" for name, path, who in PAGES]
-        endpoints = ", ".join(
+        cobots = ", ".join(
             f"{c.name} opc.tcp://127.0.0.1:{plan.cobot_ports[c.name]}" for c in demo.cobots
         )
-        lines.append(f"Simulated cobots: {endpoints}")
-        lines += cobots
-        if cases:
-            lines += ["Cases started (operators: take their tasks on the tablet):", *cases]
+        lines.append(f"Simulated cobots: {cobots}")
+        prepared = [p.cobot for p in preparations if p.problem is None]
+        if prepared:
+            lines.append(f"{', '.join(prepared)}: {PREPARED}")
+        lines += [
+            self.style.WARNING(f"{p.cobot}: not prepared: {p.problem}")
+            for p in preparations
+            if p.problem is not None
+        ]
+        lines += cases
         if plan.redis:
             lines.append("Jobs: a Celery worker with beat, and the cobot monitor, on REDIS_URL")
         else:
