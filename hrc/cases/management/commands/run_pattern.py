@@ -18,6 +18,7 @@ from typing import Any
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
 from hrc.cases.simulation import Simulation, case_variants
+from hrc.database import ensure_migrated
 from hrc.engine.check import check_document
 from hrc.engine.document import FormatError, parse_json, read_pattern
 
@@ -50,6 +51,9 @@ class Command(BaseCommand):
             raise CommandError("--cases must be 1 or more.")
         if options["time_scale"] < 0:
             raise CommandError("--time-scale must be 0 or more.")
+        # Its cases live in a scratch organisation, so right after cloning it may create and
+        # migrate the embedded SQLite itself; a PostgreSQL database it only reports.
+        ensure_migrated(migrate_sqlite=True)
         with tempfile.TemporaryDirectory(prefix="hrc-run-pattern-") as workdir, Simulation(
             document, Path(workdir), time_scale=options["time_scale"],
             inline=options["workers"] == "inline", seed=options["seed"],

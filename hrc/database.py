@@ -1,0 +1,54 @@
+"""Is the database ready for a management command: reachable and migrated.
+
+A fresh clone has no `var/` and so no SQLite file; a new PostgreSQL database has
+no tables. Without this check a command that needs the database ends in a
+traceback ("unable to open database file", "relation … does not exist").
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from django.core.management import call_command
+from django.core.management.base import CommandError
+from django.db import DEFAULT_DB_ALIAS, DatabaseError, connections
+from django.db.migrations.executor import MigrationExecutor
+
+MIGRATE = ".venv/bin/python manage.py migrate"
+
+
+def ensure_migrated(*, migrate_sqlite: bool = False, alias: str = DEFAULT_DB_ALIAS) -> None:
+    """Raises CommandError with one line saying what to run when the database is not ready.
+
+    With `migrate_sqlite`, a SQLite database (the embedded default) is created and
+    migrated here instead: a scratch tool the README runs right after cloning may do
+    that by itself, while a shared PostgreSQL database is migrated by a person.
+    """
+    connection = connections[alias]
+    if connection.vendor == "sqlite" and migrate_sqlite:
+        Path(connection.settings_dict["NAME"]).parent.mkdir(parents=True, exist_ok=True)
+    try:
+        executor = MigrationExecutor(connection)
+        pending = executor.migration_plan(executor.loader.graph.leaf_nodes())
+    except DatabaseError as error:
+        first_line = str(error).splitlines()[0] if str(error) else type(error).__name__
+        where = _where(connection.vendor, connection.settings_dict["NAME"])
+        hint = (
+            f"run `make demo` or `{MIGRATE}` first"
+            if connection.vendor == "sqlite"
+            else "is it running, and does DATABASE_URL name it?"
+        )
+        raise CommandError(f"Cannot open {where} ({first_line}); {hint}") from None
+    if not pending:
+        return
+    if connection.vendor == "sqlite" and migrate_sqlite:
+        call_command("migrate", interactive=False, verbosity=0, database=alias)
+        return
+    where = _where(connection.vendor, connection.settings_dict["NAME"])
+    raise CommandError(
+        f"{where} is not migrated ({len(pending)} migration(s) to apply): run `{MIGRATE}` first."
+    )
+
+
+def _where(vendor: str, name: object) -> str:
+    return f"the SQLite database {name}" if vendor == "sqlite" else f"the {vendor} database {name}"
