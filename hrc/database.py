@@ -34,7 +34,7 @@ def ensure_migrated(*, migrate_sqlite: bool = False, alias: str = DEFAULT_DB_ALI
         first_line = str(error).splitlines()[0] if str(error) else type(error).__name__
         where = _where(connection.vendor, connection.settings_dict["NAME"])
         hint = (
-            f"run `make demo` or `{MIGRATE}` first"
+            f"does its folder exist? Then run `{MIGRATE}`"
             if connection.vendor == "sqlite"
             else "is it running, and does DATABASE_URL name it?"
         )
@@ -46,7 +46,7 @@ def ensure_migrated(*, migrate_sqlite: bool = False, alias: str = DEFAULT_DB_ALI
         return
     where = _where(connection.vendor, connection.settings_dict["NAME"])
     raise CommandError(
-        f"{where} is not migrated ({len(pending)} migration(s) to apply): run `{MIGRATE}` first."
+        f"{where[:1].upper()}{where[1:]} is not migrated ({len(pending)} migration(s) to apply): run `{MIGRATE}` first."
     )
 
 

@@ -22,16 +22,29 @@ def manage(scratch: Path, *arguments: str) -> subprocess.CompletedProcess[str]:
     )
 
 
-def test_a_cobot_command_on_a_fresh_clone_says_to_run_the_demo_or_migrate(tmp_path: Path) -> None:
-    result = manage(tmp_path, "cobot_call", "cobot1", "PowerOn")
+def test_a_cobot_command_on_a_fresh_clone_says_to_migrate(tmp_path: Path) -> None:
+    result = manage(tmp_path, "cobot_call", "cobot1", "PowerOn")  # no var/ yet
 
     assert result.returncode == 1
     assert "Traceback" not in result.stderr
     [line] = result.stderr.strip().splitlines()
-    assert "unable to open database file" in line
-    assert "manage.py migrate" in line
-    assert "make demo" in line
-    assert not (tmp_path / "var").exists()
+    assert "is not migrated" in line
+    assert "`.venv/bin/python manage.py migrate`" in line
+
+
+def test_a_sqlite_database_whose_folder_is_missing_is_named(tmp_path: Path) -> None:
+    missing = tmp_path / "missing" / "hrc.sqlite3"
+    environment = embedded_environment(tmp_path) | {"DATABASE_URL": f"sqlite:///{missing}"}
+
+    result = subprocess.run(
+        [sys.executable, "manage.py", "live_cobots"], cwd=ROOT, env=environment,
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr
+    [line] = result.stderr.strip().splitlines()
+    assert f"Cannot open the SQLite database {missing} (unable to open database file)" in line
 
 
 def test_a_command_on_a_database_never_migrated_says_to_migrate(tmp_path: Path) -> None:
