@@ -14,10 +14,11 @@ import django
 
 django.setup()
 
-from django.db import connection, connections  # noqa: E402
+from django.db import connection, connections, transaction  # noqa: E402
 
 from hrc.cases import services  # noqa: E402
-from hrc.cases.models import Case, CaseEvent  # noqa: E402
+from hrc.cases.models import Case, CaseEvent, Job, Message  # noqa: E402
+from hrc.cobots.models import Cobot  # noqa: E402
 from hrc.database import ensure_migrated  # noqa: E402
 from hrc.organisations.choices import Role  # noqa: E402
 from tests import factories  # noqa: E402
@@ -95,6 +96,7 @@ def main(count: int) -> dict[str, Any]:
         thread.join()
     return {
         "errors": errors,
+        "row_locks": row_locks(),
         "cases": [
             {
                 "completed": sorted(
@@ -111,6 +113,18 @@ def main(count: int) -> dict[str, Any]:
             for case in cases
         ],
     }
+
+
+def row_locks() -> int:
+    """The runtime's select_for_update forms, evaluated on SQLite (where Django drops them)."""
+    with transaction.atomic():
+        found = [
+            *Cobot.objects.select_for_update(of=("self",), no_key=True),
+            *Job.objects.select_for_update(of=("self",), no_key=True).select_related("cobot"),
+            *Message.objects.select_for_update(skip_locked=True),
+            *Case.objects.select_for_update(nowait=True),
+        ]
+    return len(found)
 
 
 if __name__ == "__main__":

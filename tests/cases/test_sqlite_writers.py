@@ -2,7 +2,9 @@
 parallel tasks of the same case at the same moment (threads, each with its own connection)
 meet no "database is locked" and lose no update — every case records both completions and
 offers the join. With a DEFERRED begin (SQLite's default) the second writer's lock upgrade
-fails at once with "database is locked"; IMMEDIATE (hrc/settings/base.py) queues it."""
+fails at once with "database is locked"; IMMEDIATE (hrc/settings/base.py) queues it. The
+runtime's select_for_update forms (of, no_key, skip_locked, nowait) raise no
+NotSupportedError there: Django drops them on a database without row locks."""
 
 from __future__ import annotations
 
@@ -30,6 +32,7 @@ def test_two_operators_completing_one_case_at_once_lose_nothing_on_sqlite(tmp_pa
     assert "database is locked" not in result.stderr
     outcome = json.loads(result.stdout.splitlines()[-1])
     assert outcome["errors"] == []
+    assert outcome["row_locks"] == CASES  # no NotSupportedError; only cases, no cobot or job
     assert len(outcome["cases"]) == CASES
     for case in outcome["cases"]:
         assert case == {"completed": ["left", "prepare", "right"], "open": ["join"]}
