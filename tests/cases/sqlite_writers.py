@@ -6,8 +6,10 @@ say, and the errors the threads met. test_sqlite_writers.py checks it."""
 from __future__ import annotations
 
 import json
+import socket
 import sys
 import threading
+import time
 from typing import Any
 
 import django
@@ -16,8 +18,9 @@ django.setup()
 
 from django.db import connection, connections, transaction  # noqa: E402
 
-from hrc.cases import services  # noqa: E402
-from hrc.cases.models import Case, CaseEvent, Job, Message  # noqa: E402
+from hrc.cases import jobs, services  # noqa: E402
+from hrc.cases.choices import InterruptionMode  # noqa: E402
+from hrc.cases.models import Case, CaseEvent, Interruption, Job, Message  # noqa: E402
 from hrc.cobots.models import Cobot  # noqa: E402
 from hrc.database import ensure_migrated  # noqa: E402
 from hrc.organisations.choices import Role  # noqa: E402
@@ -97,6 +100,7 @@ def main(count: int) -> dict[str, Any]:
     return {
         "errors": errors,
         "row_locks": row_locks(),
+        "pause": pause_a_silent_cobot(cases[0], first),
         "cases": [
             {
                 "completed": sorted(
@@ -112,6 +116,45 @@ def main(count: int) -> dict[str, Any]:
             }
             for case in cases
         ],
+    }
+
+
+def pause_a_silent_cobot(case: Case, operator: Any) -> dict[str, Any]:
+    """Pauses a cobot whose gateway accepts the connection and never answers, while an
+    operator's write waits: how long each took, and what the interruption recorded."""
+    silent = socket.socket()
+    silent.bind(("127.0.0.1", 0))
+    silent.listen()
+    cobot = factories.make_cobot(
+        case.organisation, endpoint=f"opc.tcp://127.0.0.1:{silent.getsockname()[1]}"
+    )
+    item = factories.open_work_item(case, "join")
+    interruption = Interruption.objects.create(
+        case=case, work_item=item, operator_work_item=item, cobot=cobot,
+        mode=InterruptionMode.PAUSE,
+    )  # fmt: skip
+    started = time.monotonic()
+
+    def pause() -> None:
+        try:
+            jobs.interrupt_cobot(interruption.pk)
+        finally:
+            connections.close_all()
+
+    pausing = threading.Thread(target=pause)
+    pausing.start()
+    time.sleep(0.5)  # the pause is waiting for the gateway by now
+    writing = time.monotonic()
+    services.claim_work_item(item.pk, user=operator)
+    wrote = time.monotonic() - writing
+    pausing.join()
+    silent.close()
+    interruption.refresh_from_db()
+    return {
+        "pause_seconds": time.monotonic() - started,
+        "write_seconds": wrote,
+        "paused_at": str(interruption.paused_at),
+        "error": interruption.error,
     }
 
 

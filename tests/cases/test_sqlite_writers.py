@@ -34,5 +34,11 @@ def test_two_operators_completing_one_case_at_once_lose_nothing_on_sqlite(tmp_pa
     assert outcome["errors"] == []
     assert outcome["row_locks"] == CASES  # no NotSupportedError; only cases, no cobot or job
     assert len(outcome["cases"]) == CASES
+    # An operator's write does not wait for a cobot pause that waits on a silent gateway.
+    pause = outcome["pause"]
+    assert pause["pause_seconds"] > 2, pause
+    assert pause["write_seconds"] < 1, pause
+    assert pause["paused_at"] == "None", pause
+    assert pause["error"].startswith("pause: "), pause
     for case in outcome["cases"]:
         assert case == {"completed": ["left", "prepare", "right"], "open": ["join"]}
