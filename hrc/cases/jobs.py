@@ -23,12 +23,15 @@ import datetime as dt
 import logging
 import os
 import socket
-from collections.abc import Callable
+import threading
+from collections import defaultdict
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
 from django.conf import settings
-from django.db import transaction
+from django.db import connection, transaction
 from django.db.models import Exists, OuterRef, Q, QuerySet
 from django.utils import timezone
 
@@ -492,6 +495,28 @@ def _locked_interruption(interruption_id: int) -> Interruption:
     )
 
 
+# The embedded default's senders of one interruption's commands, all threads of one process.
+_embedded_senders: defaultdict[int, threading.Lock] = defaultdict(threading.Lock)
+
+
+@contextmanager
+def _sole_sender(interruption_id: int) -> Iterator[Interruption]:
+    """The interruption, read by the only thread that may command its cobot for it until exit.
+
+    On PostgreSQL its row lock, held across the cobot call, blocks only that row. The
+    embedded SQLite has one write lock for the whole database, taken at BEGIN: held
+    across a call to an unreachable cobot it would stall every writer for the connect
+    timeout. There (no Redis: one process) a lock per interruption serialises the
+    senders instead, and each write is a short transaction of its own.
+    """
+    if connection.vendor == "sqlite" and not settings.REDIS_URL:
+        with _embedded_senders[interruption_id]:
+            yield Interruption.objects.select_related("cobot").get(pk=interruption_id)
+        return
+    with transaction.atomic():
+        yield _locked_interruption(interruption_id)
+
+
 def _command(interruption: Interruption, *, pause: bool) -> bool:
     """Pauses or resumes (slows or restores the speed of) the cobot; records why when it cannot."""
     driver = driver_for_cobot(interruption.cobot)
@@ -510,8 +535,7 @@ def _command(interruption: Interruption, *, pause: bool) -> bool:
 
 def interrupt_cobot(interruption_id: int) -> None:
     """Pauses (or slows) the cobot for an interruption still open; never twice."""
-    with transaction.atomic():
-        interruption = _locked_interruption(interruption_id)
+    with _sole_sender(interruption_id) as interruption:
         if interruption.ended_at is not None or interruption.paused_at is not None:
             return
         if _command(interruption, pause=True):
@@ -524,8 +548,7 @@ def resume_cobot(interruption_id: int) -> None:
 
     A resume that fails is left for the sweeper, which sends it again until it succeeds.
     """
-    with transaction.atomic():
-        interruption = _locked_interruption(interruption_id)
+    with _sole_sender(interruption_id) as interruption:
         if interruption.ended_at is None or interruption.resumed_at is not None:
             return
         others = Interruption.objects.filter(

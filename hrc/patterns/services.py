@@ -118,13 +118,17 @@ def import_pattern(
 def publish_pattern(pattern: PatternModel, *, published_by: User) -> PatternVersion:
     """Publishes the pattern's current draft as its next version; raises PublishRefused.
 
-    The pattern row is locked for the whole check, so the draft that is checked
-    is the draft that is published, and concurrent publishes number 1, 2, 3…
-    without gaps or collisions.
+    The draft that is checked is the draft that is published, and concurrent
+    publishes number 1, 2, 3… without gaps or collisions (the pattern row lock).
     """
+    # The check may take seconds, and on the embedded SQLite a transaction holds the whole
+    # database's write lock: check first, and again under the lock only if the draft changed.
+    draft = PatternModel.objects.values_list("draft", flat=True).get(pk=pattern.pk)
+    report = check_report(draft)
     with transaction.atomic():
         locked = PatternModel.objects.select_for_update().get(pk=pattern.pk)
-        report = check_report(locked.draft)
+        if locked.draft != draft:
+            report = check_report(locked.draft)
         if not is_publishable(report):
             raise PublishRefused(report)
         last = locked.versions.aggregate(last=Max("number"))["last"] or 0

@@ -87,7 +87,9 @@ if DATABASE_URL:
             "timeout": float(env_str("HRC_DB_POOL_TIMEOUT") or 10),
         }
 else:
-    # The embedded default: one file under var/, created by `migrate`.
+    # The embedded default: one file under var/, created by `migrate`. A fresh clone has no
+    # var/ yet, and SQLite does not make folders: without this `migrate` could not open it.
+    VAR_DIR.mkdir(parents=True, exist_ok=True)
     DATABASES = {
         "default": {"ENGINE": "django.db.backends.sqlite3", "NAME": str(VAR_DIR / "hrc.sqlite3")}
     }

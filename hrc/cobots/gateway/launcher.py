@@ -82,10 +82,14 @@ class GatewayProcess:
                 env={**os.environ, "PYTHONUNBUFFERED": "1"},
             )
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and self.process.poll() is None:
-            if "gateway serving" in self.output(offset):
-                return self
-            time.sleep(0.02)
+        try:
+            while time.monotonic() < deadline and self.process.poll() is None:
+                if "gateway serving" in self.output(offset):
+                    return self
+                time.sleep(0.02)
+        except BaseException:
+            self.kill()  # stopped while it starts (Ctrl-C, SIGTERM): not left serving alone
+            raise
         output = self.output(offset)
         self.kill()
         raise RuntimeError(f"The gateway did not start:\n{output}")

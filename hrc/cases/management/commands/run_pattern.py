@@ -11,13 +11,19 @@ How simulated operators fill forms, and how a document's cases may differ
 from __future__ import annotations
 
 import json
+import signal
 import tempfile
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from types import FrameType
+from typing import Any, NoReturn
 
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
 from hrc.cases.simulation import Simulation, case_variants
+from hrc.database import ensure_migrated
 from hrc.engine.check import check_document
 from hrc.engine.document import FormatError, parse_json, read_pattern
 
@@ -50,10 +56,17 @@ class Command(BaseCommand):
             raise CommandError("--cases must be 1 or more.")
         if options["time_scale"] < 0:
             raise CommandError("--time-scale must be 0 or more.")
-        with tempfile.TemporaryDirectory(prefix="hrc-run-pattern-") as workdir, Simulation(
-            document, Path(workdir), time_scale=options["time_scale"],
-            inline=options["workers"] == "inline", seed=options["seed"],
-        ) as simulation:  # fmt: skip
+        # Its cases live in a scratch organisation, so right after cloning it may create and
+        # migrate the embedded SQLite itself; a PostgreSQL database it only reports.
+        ensure_migrated(migrate_sqlite=True)
+        with (
+            _exit_on_sigterm(),
+            tempfile.TemporaryDirectory(prefix="hrc-run-pattern-") as workdir,
+            Simulation(
+                document, Path(workdir), time_scale=options["time_scale"],
+                inline=options["workers"] == "inline", seed=options["seed"],
+            ) as simulation,
+        ):  # fmt: skip
             events = simulation.run(options["cases"], timeout=options["timeout"])
         for event in events:
             if options["json"]:
@@ -85,3 +98,21 @@ class Command(BaseCommand):
         except ValueError as error:
             raise CommandError(f"{path} cannot run: {error}") from None
         return data
+
+
+@contextmanager
+def _exit_on_sigterm() -> Iterator[None]:
+    """SIGTERM (a test's or a supervisor's stop) unwinds like Ctrl-C, so the simulation stops
+    its gateway processes; Python's default ends at once and leaves them running."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signal handlers can only be set from the main thread (call_command elsewhere)
+        return
+
+    def leave(signum: int, frame: FrameType | None) -> NoReturn:
+        raise SystemExit(128 + signum)
+
+    previous = signal.signal(signal.SIGTERM, leave)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

@@ -10,6 +10,7 @@ from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import SyncDriver, driver_for, driver_for_cobot
 from hrc.cobots.models import Cobot
 from hrc.cobots.validators import validate_endpoint
+from hrc.database import ensure_migrated
 
 
 class CobotCommand(BaseCommand):
@@ -39,6 +40,7 @@ class CobotCommand(BaseCommand):
                     f"--endpoint: {' '.join(getattr(error, 'messages', [str(error)]))}"
                 ) from None
             return driver_for(name, options["endpoint"], **timeouts)
+        ensure_migrated()
         cobots = Cobot.objects.filter(name=name).select_related("organisation")
         if options["organisation"]:
             cobots = cobots.filter(organisation__name=options["organisation"])

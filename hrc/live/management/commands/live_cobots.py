@@ -6,6 +6,7 @@ from typing import Any
 
 from django.core.management.base import BaseCommand, CommandParser
 
+from hrc.database import ensure_migrated
 from hrc.live.monitor import Monitor
 from hrc.process import freeze_start_up
 
@@ -27,6 +28,7 @@ class Command(BaseCommand):
         if options["interval"] <= 0:
             self.stderr.write("--interval must be above 0 seconds.")
             raise SystemExit(2)
+        ensure_migrated()
         monitor = Monitor(options["organisation"], options["interval"])
         self.stdout.write("live monitor watching cobots", ending="\n")
         self.stdout.flush()

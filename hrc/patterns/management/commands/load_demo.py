@@ -12,6 +12,7 @@ from typing import Any
 from django.core.exceptions import ValidationError
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
+from hrc.database import ensure_migrated
 from hrc.demo import library, organisation
 from hrc.demo.library import EXAMPLES_DIR
 
@@ -63,6 +64,7 @@ class Command(BaseCommand):
     def handle(self, *args: Any, **options: Any) -> None:
         endpoints = _filled(options["cobot_endpoint"], "--cobot-endpoint")
         credentials = _filled(options["cobot_credentials"], "--cobot-credentials")
+        ensure_migrated()
         try:
             demo = organisation.provision(
                 endpoints=endpoints,
