@@ -46,6 +46,7 @@ from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
 from hrc.cobots import urua
 from hrc.cobots.control import running_commands
+from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
     CobotNotReady,
     CommandRefused,
@@ -97,6 +98,15 @@ def run_next_job(job_id: int) -> None:
             result = _execute(lease, on_sent=hold.release)
         except DriverError as error:
             fail_job(lease, error)
+        except Exception as error:
+            # A fault of ours, not the cobot's answer: the step's outcome is unknown, so it is
+            # never sent again by itself (a person retries, with the step's token).
+            logger.exception("Job %s failed unexpectedly", lease.job_id)
+            message = (
+                f"hrc failed while running the step ({error!r}); it is not sent again by itself. "
+                "See the workers' log, check the cobot, then retry or skip."
+            )
+            fail_job(lease, DriverError(message))
         else:
             finish_job(lease, result)
     finally:
@@ -261,9 +271,10 @@ def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
 def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) -> None:
     """Loads and plays the step's program when the cobot is idle in another one.
 
-    Never powers the arm on and never clears a stop: a cobot that is not
-    running (powered, brakes released), or whose cell a tablet stopped after
-    this job was leased, is an incident for a person.
+    Never powers the arm on, releases its brakes or clears a stop: a cobot that
+    is not running (powered, brakes released), or whose cell a tablet stopped
+    after this job was leased, raises the error that names its state and what
+    a person does (readiness.not_ready); one on its way up is retried.
     """
 
     def ready(state: dict[str, Any]) -> bool:
@@ -277,12 +288,9 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     if ready(state):
         return
     loaded = str(state.get("CurrentProgram") or "")
-    if state.get("RobotMode") != urua.ROBOT_MODE_RUNNING:
-        raise CobotNotReady(
-            f"{driver.name} is in robot mode {state.get('RobotMode')!r}: power it on and release "
-            "the brakes at the cell; hrc does not do that by itself.",
-            state=state,
-        )
+    problem = readiness.not_ready(driver.name, state, page=readiness.page_of(cobot_id))
+    if problem is not None:
+        raise problem
     # A STOP from a tablet may have paused the program since the lease: playing it
     # again here would undo the STOP.
     if Cobot.objects.filter(pk=cobot_id, stopped_at__isnull=False).exists():
@@ -347,7 +355,9 @@ def _ring_for_next_on_commit(job: Job) -> None:
 
 
 def fail_job(lease: Lease, error: DriverError) -> None:
-    """Retries a transient failure with back-off (same token); anything else becomes an incident."""
+    """Retries a transient failure with back-off (same token); anything else, and a transient
+    one with no retry left, becomes an incident at once. Either way the error is the job's
+    `last_error` and an event of the case's timeline."""
     with transaction.atomic():
         case, job = _locked_job(lease)
         if job is None:
@@ -370,6 +380,10 @@ def fail_job(lease: Lease, error: DriverError) -> None:
         else:
             job.state, job.ended_at = JobState.FAILED, timezone.now()
             job.save()
+            services.record_event(
+                case, EventType.STEP_FAILED, item=item,
+                detail={"error": str(error), "attempt": job.attempt},
+            )  # fmt: skip
             kind = (
                 IncidentKind.DEVICE_FAILED
                 if job.kind == WorkItemKind.DEVICE

@@ -57,7 +57,6 @@ from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot
 from hrc.engine.model import Pattern
-from hrc.engine.taskconfig import DEFAULT_PROGRAM
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
 from hrc.patterns import services as pattern_services
@@ -144,6 +143,9 @@ class Simulation:
     operator_delay: tuple[float, float] = (0.2, 1.0)  # seconds, times time_scale
     inline: bool = True
     seed: int | None = None
+    # Whether the person at the pendant powers the cobots on before the run (a test of a
+    # cobot left powered off says False).
+    power_on: bool = True
     organisation: Organisation = field(init=False)
     version: PatternVersion = field(init=False)
     gateways: dict[str, GatewayProcess] = field(default_factory=dict, init=False)
@@ -199,7 +201,7 @@ class Simulation:
             if types[actor] == "operator":
                 self.users[name] = self._member(f"rp-{suffix}-{name}", Role.OPERATOR)
             else:
-                self._cobots[name] = self._simulated_cobot(name, _program_of(net.pattern, actor))
+                self._cobots[name] = self._simulated_cobot(name)
         mapping = {actor.id: self._binding(actor.id) for actor in net.pattern.actors}
         services.set_default_actor_mapping(self.version, mapping)
 
@@ -213,15 +215,17 @@ class Simulation:
         Membership.objects.create(user=user, organisation=self.organisation, role=role)
         return user
 
-    def _simulated_cobot(self, actor: str, program: str) -> Cobot:
+    def _simulated_cobot(self, actor: str) -> Cobot:
+        """A fresh simulated cobot, powered on with its brakes released as the person at the
+        pendant does when a shift starts; loading and playing each step's program is left to
+        the worker (jobs._prepare), as on a plant."""
         name = f"{actor}-{self.organisation.slug}"
         gateway = GatewayProcess(name, self.workdir / f"{name}.json", time_scale=self.time_scale)
         self.gateways[actor] = gateway.start()
         self._cobot_names[actor] = name
         driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
-        driver.call("PowerOn", timeout=30)
-        driver.call("SelectProgram", program)
-        driver.call("StartProgram")
+        if self.power_on:
+            driver.call("PowerOn", timeout=30)  # the simulator's PowerOn releases the brakes too
         return Cobot.objects.create(
             organisation=self.organisation, name=name, endpoint=gateway.endpoint
         )
@@ -378,12 +382,6 @@ class Simulation:
             RunEvent(seq, at.isoformat(), case, task, actor, kind)
             for seq, (at, case, task, actor, kind) in enumerate(events, start=1)
         ]
-
-
-def _program_of(pattern: Pattern, actor: str) -> str:
-    found = pattern.actor(actor)
-    program = found.extra.get("program") if found else None
-    return program if isinstance(program, str) and program else DEFAULT_PROGRAM
 
 
 def example_for(schema: Mapping[str, Any] | None, answer: int = 0) -> dict[str, Any]:

@@ -65,6 +65,12 @@ class CobotNotReady(DriverError):
     """The cobot is not powered, not running its program, or in a mode where it cannot move."""
 
 
+class CobotStarting(CobotNotReady):
+    """The cobot is booting or powering on: it gets to Idle or Running by itself, so retry."""
+
+    transient = True
+
+
 @dataclasses.dataclass(frozen=True)
 class Fence:
     """The fencing token of a step: which step (id) and which try (attempt).

@@ -28,6 +28,7 @@ from asyncua import Client, Node, ua
 from asyncua.common.methods import call_method_full
 
 from hrc.cobots import urua
+from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
     NO_FENCE,
     CobotBusy,
@@ -120,8 +121,11 @@ class OpcUaDriver(CobotDriver):
         release_timeout: float = 10.0,
         publishing_interval: float = 0.0,
         backoff: tuple[float, float] = (0.05, 5.0),
+        page: str = "",
     ) -> None:
         self.name = name
+        # The cobot's page in hrc, named in what a person must do (readiness.not_ready).
+        self.page = page
         self.endpoint = endpoint
         self.security = security
         self.connect_timeout = connect_timeout
@@ -439,21 +443,13 @@ class OpcUaDriver(CobotDriver):
 
     def _unready(self, fence: Any) -> DriverError | None:
         """Why the cached state says the cobot cannot take a step now; None when it can."""
-        mode = self.cache[urua.STATE_ROBOT_MODE]
-        safety = self.cache[urua.STATE_SAFETY_MODE]
+        problem = readiness.not_ready(
+            self.name, self._state_from_cache(), page=self.page, endpoint=self.endpoint
+        )
+        if problem is not None:
+            # The same error, saying the step stayed here: a retry sends it with its token.
+            return type(problem)(f"{problem} Step {fence} was not sent.", state=self.cache)
         program = self.cache[urua.STATE_PROGRAM_STATE]
-        if safety not in urua.SAFETY_MODES_THAT_MOVE:
-            return CobotStopped(
-                f"{self.name} is in {safety}: a person must clear it at the cell; "
-                f"step {fence} was not sent.",
-                state=self.cache,
-            )
-        if mode != urua.ROBOT_MODE_RUNNING:
-            return CobotNotReady(
-                f"{self.name} is in robot mode {mode!r}, not Running: power it on "
-                f"(PowerOn) first; step {fence} was not sent.",
-                state=self.cache,
-            )
         if program != urua.PROGRAM_PLAYING:
             return CobotNotReady(
                 f"{self.name}'s program is {program!r}, not Playing: select and start the step "
