@@ -90,14 +90,21 @@ def run_next_job(job_id: int) -> None:
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
     # started, the queue) waits until the cobot has accepted the step (hrc/live/broadcast.py).
     hold = live.hold()
+    # When the cobot accepted the step: its work starts there, not at the lease (analytics).
+    accepted: list[dt.datetime] = []
+
+    def on_sent() -> None:  # on the drivers' event loop: no database here
+        accepted.append(timezone.now())
+        hold.release()
+
     try:
         lease = _lease_next(Q(jobs__pk=job_id))
         if lease is None:
             return
         try:
-            result = _execute(lease, on_sent=hold.release)
+            result = _execute(lease, on_sent=on_sent)
         except DriverError as error:
-            fail_job(lease, error)
+            fail_job(lease, error, accepted_at=accepted[0] if accepted else None)
         except Exception as error:
             # A fault of ours, not the cobot's answer: the step's outcome is unknown, so it is
             # never sent again by itself (a person retries, with the step's token).
@@ -106,9 +113,9 @@ def run_next_job(job_id: int) -> None:
                 f"hrc failed while running the step ({error!r}); it is not sent again by itself. "
                 "See the workers' log, check the cobot, then retry or skip."
             )
-            fail_job(lease, DriverError(message))
+            fail_job(lease, DriverError(message), accepted_at=accepted[0] if accepted else None)
         else:
-            finish_job(lease, result)
+            finish_job(lease, result, accepted_at=accepted[0] if accepted else None)
     finally:
         hold.release()
 
@@ -334,14 +341,20 @@ def _mark_sent(lease: Lease) -> bool:
     )
 
 
-def finish_job(lease: Lease, result: dict[str, Any]) -> None:
-    """Records a job's success and completes its task (now, or once func constraints allow)."""
+def finish_job(
+    lease: Lease, result: dict[str, Any], *, accepted_at: dt.datetime | None = None
+) -> None:
+    """Records a job's success and completes its task (now, or once func constraints allow).
+
+    `accepted_at`: when the cobot accepted the step (the driver's on_sent); the lease's
+    start when not given."""
     with transaction.atomic():
         case, job = _locked_job(lease)
         if job is None:
             return
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
-        job.save(update_fields=["state", "result", "ended_at"])
+        job.accepted_at = accepted_at or job.started_at
+        job.save(update_fields=["state", "result", "ended_at", "accepted_at"])
         if case.status in (CaseStatus.RUNNING, CaseStatus.SUSPENDED):
             services.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
@@ -354,15 +367,16 @@ def _ring_for_next_on_commit(job: Job) -> None:
     services.ring_for_next_job_on_commit(job.pk, job.cobot_id)
 
 
-def fail_job(lease: Lease, error: DriverError) -> None:
+def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | None = None) -> None:
     """Retries a transient failure with back-off (same token); anything else, and a transient
     one with no retry left, becomes an incident at once. Either way the error is the job's
-    `last_error` and an event of the case's timeline."""
+    `last_error` and an event of the case's timeline. `accepted_at`: when the cobot accepted
+    the step, None when it never did (then the cobot did no work for it)."""
     with transaction.atomic():
         case, job = _locked_job(lease)
         if job is None:
             return
-        job.last_error = str(error)
+        job.last_error, job.accepted_at = str(error), accepted_at
         item = job.work_item
         if error.transient and job.retries_left > 0:
             job.retries_left -= 1
