@@ -76,7 +76,10 @@ _HAND_OVER: dict[str, Any] = {
     "format": "hrc-pattern/1",
     "name": "Hand-over (1 operator, 1 cobot)",
     "declared_pattern": "synchronized",
-    "actors": [{"id": "c", "type": "cobot"}, {"id": "o", "type": "operator"}],
+    "actors": [
+        {"id": "c", "type": "cobot", "program": "Coexistence_PickAndPlace"},
+        {"id": "o", "type": "operator"},
+    ],
     "processes": [
         {
             "id": "N",

@@ -29,6 +29,7 @@ from hrc.cobots.choices import CommandOutcome, ControlCommand
 from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.models import Organisation
 from tests import factories
+from tests.cases.patterns import PROGRAM
 
 
 def _one_cobot_task() -> dict[str, Any]:
@@ -43,7 +44,10 @@ def _one_cobot_task() -> dict[str, Any]:
     return {
         "format": "hrc-pattern/1",
         "name": "pick beside loading",
-        "actors": [{"id": "c", "type": "cobot"}, {"id": "o", "type": "operator"}],
+        "actors": [
+            {"id": "c", "type": "cobot", "program": PROGRAM},
+            {"id": "o", "type": "operator"},
+        ],
         "processes": [
             {
                 "id": "N",

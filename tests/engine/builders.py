@@ -48,20 +48,28 @@ def process(
     }
 
 
+PROGRAM = "Coexistence_PickAndPlace"
+
+
 def document(
     *processes: dict[str, Any],
     constraints: list[tuple[str, str, str]] = (),  # type: ignore[assignment]
     actors: dict[str, str] | None = None,
     declared: str | None = None,
 ) -> dict[str, Any]:
-    """A document; actors default to every performer, `c…` a cobot and anything else an operator."""
+    """A document; actors default to every performer, `c…` a cobot and anything else an operator.
+
+    Each cobot runs PROGRAM (a cobot task must name its program to be checked clean)."""
     if actors is None:
         names = sorted({a for p in processes for a in p["actors"]})
         actors = {a: "cobot" if a.startswith("c") else "operator" for a in names}
     data: dict[str, Any] = {
         "format": "hrc-pattern/1",
         "name": "test",
-        "actors": [{"id": a, "type": t} for a, t in actors.items()],
+        "actors": [
+            {"id": a, "type": t, **({"program": PROGRAM} if t == "cobot" else {})}
+            for a, t in actors.items()
+        ],
         "processes": list(processes),
         "constraints": [{"from": a, "to": b, "type": t} for a, b, t in constraints],
     }
