@@ -78,7 +78,8 @@ def not_ready(
         )
     if mode in STARTING_MODES:
         return CobotStarting(
-            f"{name} is starting up ({mode}); the step waits and is tried again.", state=state
+            f"{name} is starting up ({mode}); the step is tried again while its retries last.",
+            state=state,
         )
     if mode in NO_CONTROLLER_MODES:
         return CobotUnreachable(
