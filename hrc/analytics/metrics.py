@@ -62,6 +62,19 @@ class JobRow:
     queued_at: dt.datetime
     started_at: dt.datetime | None
     ended_at: dt.datetime | None
+    accepted_at: dt.datetime | None = None
+    """When the cobot accepted the step that ended the job; None when it never did."""
+
+
+def job_busy_interval(job: JobRow, now: dt.datetime) -> Interval | None:
+    """When the job kept its cobot working: from the cobot's acceptance of the step to its end
+    (a running job: from its lease until now); None for one whose step the cobot never
+    accepted (stuck, refused, not ready), which kept the cobot from nothing."""
+    if job.ended_at is None:
+        return (job.started_at, now) if job.started_at is not None else None
+    if job.accepted_at is None:
+        return None
+    return (job.accepted_at, job.ended_at)
 
 
 @dataclass(frozen=True)
@@ -259,16 +272,17 @@ class CobotFigures:
 def cobot_figures(
     jobs: Iterable[JobRow], window: Interval | None, now: dt.datetime
 ) -> list[CobotFigures]:
-    """Per cobot (by name): the time its jobs kept it busy within the window, and their wait
-    in its queue. A running job is busy until now; jobs that overlap (a lease taken over
-    while the first worker still ran) count once."""
+    """Per cobot (by name): the time its jobs kept it working within the window
+    (job_busy_interval: not the time a step was stuck or retried), and their wait in its
+    queue. A running job is busy until now; jobs that overlap (a lease taken over while the
+    first worker still ran) count once."""
     by_cobot: dict[int, list[JobRow]] = defaultdict(list)
     for job in jobs:
         by_cobot[job.cobot_id].append(job)
     figures = []
     for cobot_id, rows in by_cobot.items():
         ran = [row for row in rows if row.started_at is not None]
-        busy_intervals = [(row.started_at, row.ended_at or now) for row in ran if row.started_at]
+        busy_intervals = [i for i in (job_busy_interval(row, now) for row in ran) if i]
         window_seconds = seconds(*window) if window else 0.0
         busy = covered_seconds(busy_intervals, window) if window else 0.0
         figures.append(

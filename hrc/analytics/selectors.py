@@ -14,7 +14,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from django.contrib.auth.models import User
-from django.db.models import Count, Max, Q, QuerySet
+from django.db.models import Count, Max, OuterRef, Q, QuerySet, Subquery
+from django.db.models.functions import Coalesce
 
 from hrc.analytics import xes
 from hrc.analytics.gantt import ActorRow, ConstraintRow, Gantt, build_gantt
@@ -26,6 +27,7 @@ from hrc.analytics.metrics import (
     VersionFigures,
     version_figures,
 )
+from hrc.cases.choices import JobState
 from hrc.cases.models import Case, CaseEvent, Interruption, Job, WorkItem
 from hrc.cases.selectors import cases_visible_to
 from hrc.cobots.models import Cobot
@@ -117,12 +119,23 @@ def case_rows(cases: QuerySet[Case]) -> list[CaseRow]:
 
 
 def item_rows(cases: QuerySet[Case]) -> list[ItemRow]:
+    """The cases' work items; a cobot task counts as started when its cobot accepted the step
+    that completed it, so time it spent stuck, queued again or retried is wait, not work."""
     fields = (
         "pk", "case_id", "task", "label", "actor", "kind", "state",
-        "offered_at", "started_at", "ended_at",
+        "offered_at", "worked_from", "ended_at",
         "completed_by__username", "claimed_by__username", "cobot__name",
     )  # fmt: skip
-    rows = WorkItem.objects.filter(case__in=cases).order_by("offered_at", "pk")
+    accepted = Job.objects.filter(work_item=OuterRef("pk"), state=JobState.SUCCEEDED)
+    rows = (
+        WorkItem.objects.filter(case__in=cases)
+        .annotate(
+            worked_from=Coalesce(
+                Subquery(accepted.order_by("-ended_at").values("accepted_at")[:1]), "started_at"
+            )
+        )
+        .order_by("offered_at", "pk")
+    )
     return [_item_row(*row) for row in rows.values_list(*fields)]
 
 
@@ -147,6 +160,7 @@ def job_rows(cases: QuerySet[Case]) -> list[JobRow]:
         "queued_at",
         "started_at",
         "ended_at",
+        "accepted_at",
     )
     jobs = Job.objects.filter(case__in=cases).order_by("queued_at", "pk")
     return [JobRow(*row) for row in jobs.values_list(*fields)]

@@ -94,5 +94,7 @@ class EventType(models.TextChoices):
     TRANSITION_FIRED = "transition-fired", "Transition fired"
     MESSAGE_RECEIVED = "message-received", "Message received"
     STEP_RETRY = "step-retry", "Step will be retried"
+    # A cobot step or device call failed for good: its error; an incident follows.
+    STEP_FAILED = "step-failed", "Step failed"
     INCIDENT_OPENED = "incident-opened", "Incident opened"
     INCIDENT_RESOLVED = "incident-resolved", "Incident resolved"

@@ -49,13 +49,13 @@ from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
 from hrc.cobots import urua
 from hrc.cobots.control import running_commands
+from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
     CobotNotReady,
     CommandRefused,
     DriverError,
     Fence,
     StepCommand,
-    cannot_move,
 )
 from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
@@ -93,22 +93,32 @@ def run_next_job(job_id: int) -> None:
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
     # started, the queue) waits until the cobot has accepted the step (hrc/live/broadcast.py).
     hold = live.hold()
+    # When the cobot accepted the step: its work starts there, not at the lease (analytics).
+    accepted: list[dt.datetime] = []
+
+    def on_sent() -> None:  # on the drivers' event loop: no database here
+        accepted.append(timezone.now())
+        hold.release()
+
     try:
         lease = _lease_next(Q(jobs__pk=job_id))
         if lease is None:
             return
         try:
-            result = _execute(lease, on_sent=hold.release)
+            result = _execute(lease, on_sent=on_sent)
         except DriverError as error:
-            fail_job(lease, error)
+            fail_job(lease, error, accepted_at=accepted[0] if accepted else None)
         except Exception as error:
-            # A fault of ours, not the cobot's answer: a person decides at once (the step's
-            # token keeps a retry exactly-once), instead of a job left running until the
-            # sweeper takes it back, again and again.
+            # A fault of ours, not the cobot's answer: the step's outcome is unknown, so it is
+            # never sent again by itself (a person retries, with the step's token).
             logger.exception("Job %s failed unexpectedly", lease.job_id)
-            fail_job(lease, DriverError(f"The worker failed unexpectedly: {error!r}."))
+            message = (
+                f"hrc failed while running the step ({error!r}); it is not sent again by itself. "
+                "See the workers' log, check the cobot, then retry or skip."
+            )
+            fail_job(lease, DriverError(message), accepted_at=accepted[0] if accepted else None)
         else:
-            finish_job(lease, result)
+            finish_job(lease, result, accepted_at=accepted[0] if accepted else None)
     finally:
         hold.release()
 
@@ -271,9 +281,10 @@ def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
 def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) -> None:
     """Loads and plays the step's program when the cobot is idle in another one.
 
-    Never powers the arm on and never clears a stop: a cobot that is not
-    running (powered, brakes released), or whose cell a tablet stopped after
-    this job was leased, is an incident for a person.
+    Never powers the arm on, releases its brakes or clears a stop: a cobot that
+    is not running (powered, brakes released), or whose cell a tablet stopped
+    after this job was leased, raises the error that names its state and what
+    a person does (readiness.not_ready); one on its way up is retried.
     """
 
     def ready(state: dict[str, Any]) -> bool:
@@ -287,7 +298,7 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     if ready(state):
         return
     loaded = str(state.get("CurrentProgram") or "")
-    problem = cannot_move(driver.name, state, page=f"/cobots/{cobot_id}/")
+    problem = readiness.not_ready(driver.name, state, page=readiness.page_of(cobot_id))
     if problem is not None:
         raise problem
     # A STOP from a tablet may have paused the program since the lease: playing it
@@ -333,14 +344,20 @@ def _mark_sent(lease: Lease) -> bool:
     )
 
 
-def finish_job(lease: Lease, result: dict[str, Any]) -> None:
-    """Records a job's success and completes its task (now, or once func constraints allow)."""
+def finish_job(
+    lease: Lease, result: dict[str, Any], *, accepted_at: dt.datetime | None = None
+) -> None:
+    """Records a job's success and completes its task (now, or once func constraints allow).
+
+    `accepted_at`: when the cobot accepted the step (the driver's on_sent); the lease's
+    start when not given."""
     with transaction.atomic():
         case, job = _locked_job(lease)
         if job is None:
             return
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
-        job.save(update_fields=["state", "result", "ended_at"])
+        job.accepted_at = accepted_at or job.started_at
+        job.save(update_fields=["state", "result", "ended_at", "accepted_at"])
         if case.status in (CaseStatus.RUNNING, CaseStatus.SUSPENDED):
             services.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
@@ -353,13 +370,16 @@ def _ring_for_next_on_commit(job: Job) -> None:
     services.ring_for_next_job_on_commit(job.pk, job.cobot_id)
 
 
-def fail_job(lease: Lease, error: DriverError) -> None:
-    """Retries a transient failure with back-off (same token); anything else becomes an incident."""
+def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | None = None) -> None:
+    """Retries a transient failure with back-off (same token); anything else, and a transient
+    one with no retry left, becomes an incident at once. Either way the error is the job's
+    `last_error` and an event of the case's timeline. `accepted_at`: when the cobot accepted
+    the step, None when it never did (then the cobot did no work for it)."""
     with transaction.atomic():
         case, job = _locked_job(lease)
         if job is None:
             return
-        job.last_error = str(error)
+        job.last_error, job.accepted_at = str(error), accepted_at
         item = job.work_item
         if error.transient and job.retries_left > 0:
             job.retries_left -= 1
@@ -377,6 +397,10 @@ def fail_job(lease: Lease, error: DriverError) -> None:
         else:
             job.state, job.ended_at = JobState.FAILED, timezone.now()
             job.save()
+            services.record_event(
+                case, EventType.STEP_FAILED, item=item,
+                detail={"error": str(error), "attempt": job.attempt},
+            )  # fmt: skip
             kind = (
                 IncidentKind.DEVICE_FAILED
                 if job.kind == WorkItemKind.DEVICE

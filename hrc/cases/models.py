@@ -142,6 +142,12 @@ class Job(models.Model):
     next_try_at = models.DateTimeField(help_text="Not before: the back-off after a failure.")
     sent_at = models.DateTimeField(null=True, blank=True, help_text="When a device call went out.")
     started_at = models.DateTimeField(null=True, blank=True)
+    accepted_at = models.DateTimeField(
+        null=True,
+        blank=True,
+        help_text="When the cobot accepted the step of the attempt that ended the job (a device "
+        "call: when it went out); the cobot worked from here to ended_at.",
+    )
     ended_at = models.DateTimeField(null=True, blank=True)
     waiting_for = models.CharField(max_length=300, blank=True, help_text="Why it has not started.")
     last_error = models.TextField(blank=True)

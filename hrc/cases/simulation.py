@@ -143,6 +143,9 @@ class Simulation:
     operator_delay: tuple[float, float] = (0.2, 1.0)  # seconds, times time_scale
     inline: bool = True
     seed: int | None = None
+    # Whether the person at the pendant powers the cobots on before the run (a test of a
+    # cobot left powered off says False).
+    power_on: bool = True
     organisation: Organisation = field(init=False)
     version: PatternVersion = field(init=False)
     gateways: dict[str, GatewayProcess] = field(default_factory=dict, init=False)
@@ -213,14 +216,16 @@ class Simulation:
         return user
 
     def _simulated_cobot(self, actor: str) -> Cobot:
-        """A simulated cobot as a plant has it before a shift: the person at the pendant has
-        powered it on and released its brakes; loading each step's program is hrc's job."""
+        """A fresh simulated cobot, powered on with its brakes released as the person at the
+        pendant does when a shift starts; loading and playing each step's program is left to
+        the worker (jobs._prepare), as on a plant."""
         name = f"{actor}-{self.organisation.slug}"
         gateway = GatewayProcess(name, self.workdir / f"{name}.json", time_scale=self.time_scale)
         self.gateways[actor] = gateway.start()
         self._cobot_names[actor] = name
         driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
-        driver.call("PowerOn", timeout=30)
+        if self.power_on:
+            driver.call("PowerOn", timeout=30)  # the simulator's PowerOn releases the brakes too
         return Cobot.objects.create(
             organisation=self.organisation, name=name, endpoint=gateway.endpoint
         )

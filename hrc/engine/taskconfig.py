@@ -8,9 +8,9 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
   - cobot tasks, either a program step
     `"step": {"program": "Coexistence_PickAndPlace", "number": 2, "workspace": 0, "poses": [[x, y, z, rx, ry, rz]]}`
     or a device call `"device": {"call": "part-detection.scan", "args": {}}`;
-    a step's program may instead come from its actor's `"program"` key, and a
-    step without a number is step 1; a cobot task that names no program
-    either way is a `task-config` error, never run with a program nobody chose;
+    a cobot task with neither runs step 1 of its actor's program (the actor's
+    `"program"` key); a step that names no program, neither itself nor through
+    its actor, is a `task-config` error: there is no default program;
   - any task: `outputs` (`{"case key": "expression over result and data"}`;
     without it the whole result is stored under the task's id), `timeout`
     (seconds) and `retries` (automatic retries of a cobot or device task).
@@ -33,7 +33,7 @@ from typing import Any, Final, Literal
 
 from hrc.engine import expressions
 from hrc.engine.issues import Issue, error
-from hrc.engine.model import Pattern, Transition
+from hrc.engine.model import Actor, Pattern, Transition
 
 TaskKind = Literal["operator", "step", "device"]
 
@@ -130,9 +130,8 @@ def task_config(pattern: Pattern, transition: Transition) -> TaskConfig:
         raise ConfigError(t, "a cobot task runs either a 'step' or a 'device' call, not both.")
     if "device" in raw:
         return TaskConfig("device", device=_device(t, raw["device"]), **common)
-    return TaskConfig(
-        "step", step=_step(t, raw.get("step", {}), actor.extra.get("program")), **common
-    )
+    actor_program = actor.extra.get("program")
+    return TaskConfig("step", step=_step(t, raw.get("step", {}), actor, actor_program), **common)
 
 
 def _common(t: str, raw: Mapping[str, Any]) -> dict[str, Any]:
@@ -165,13 +164,16 @@ def _common(t: str, raw: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
-def _step(t: str, raw: object, default_program: object) -> StepConfig:
+def _step(t: str, raw: object, actor: Actor, actor_program: object) -> StepConfig:
     if not isinstance(raw, Mapping):
         raise ConfigError(t, "'step' must be an object.")
-    program = raw.get("program", default_program)
+    program = raw.get("program", actor_program)
     if program is None:
+        # No default: a cobot running another pattern's program by surprise is a hazard.
         raise ConfigError(
-            t, "the cobot task names no program: give its step a 'program', or its actor one."
+            t,
+            f"the cobot task names no program: give its 'step' a 'program', or its actor "
+            f'{actor.id!r} a "program" key.',
         )
     if not isinstance(program, str) or not program:
         raise ConfigError(t, "the step's 'program' must be a program name.")

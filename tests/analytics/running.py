@@ -72,13 +72,17 @@ def pin(
     jobs_: dict[str, tuple[float, float | None, float | None]] | None = None,
 ) -> None:
     """Sets the case's and its rows' times (seconds after START): items and jobs by task,
-    as (offered or queued, started, ended)."""
+    as (offered or queued, started, ended); a cobot item's start is when its step was accepted."""
     Case.objects.filter(pk=case.pk).update(
         started_at=at(started), ended_at=at(ended) if ended is not None else None
     )
     for task, (offered, began, done) in items.items():
         WorkItem.objects.filter(case=case, task=task).update(
             offered_at=at(offered), started_at=_at(began), ended_at=_at(done)
+        )
+        # A cobot task's item starts when its cobot accepted the step (analytics.selectors).
+        Job.objects.filter(case=case, work_item__task=task, accepted_at__isnull=False).update(
+            accepted_at=_at(began)
         )
     for task, (queued, began, done) in (jobs_ or {}).items():
         Job.objects.filter(case=case, work_item__task=task).update(

@@ -44,10 +44,20 @@ def item(
     )  # fmt: skip
 
 
-def job(pk: int, cobot: int, queued: float, started: float | None, ended: float | None) -> JobRow:
+def job(
+    pk: int,
+    cobot: int,
+    queued: float,
+    started: float | None,
+    ended: float | None,
+    accepted: float | None = None,
+) -> JobRow:
+    """A job whose step the cobot accepted at `accepted` (by default as soon as it was leased)."""
+    accepted = started if accepted is None else accepted
     return JobRow(
         pk, 1, cobot, f"cobot{cobot}", "succeeded", at(queued),
         at(started) if started is not None else None, at(ended) if ended is not None else None,
+        at(accepted) if accepted is not None else None,
     )  # fmt: skip
 
 
@@ -132,6 +142,24 @@ def test_a_running_job_keeps_its_cobot_busy_until_now() -> None:
     (figures,) = cobot_figures(jobs, (at(0), at(90)), now=at(90))
     assert figures.busy_seconds == 30.0
     assert figures.utilisation == pytest.approx(1 / 3)
+
+
+def test_a_cobot_works_only_from_accepting_its_step_not_while_the_step_was_stuck() -> None:
+    failed = JobRow(
+        2,
+        1,
+        1,
+        "cobot1",
+        "failed",
+        at(40),
+        at(40),
+        at(80),
+        None,  # never accepted: stuck
+    )
+    jobs = [job(1, cobot=1, queued=0, started=0, ended=30, accepted=25), failed]
+    (figures,) = cobot_figures(jobs, (at(0), at(100)), now=at(100))
+    assert figures.busy_seconds == 5.0
+    assert figures.utilisation == pytest.approx(0.05)
 
 
 def test_without_a_window_a_cobot_has_no_utilisation() -> None:

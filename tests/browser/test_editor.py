@@ -181,6 +181,12 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     page.get_by_role("button", name="Cobot lane").click()
     page.get_by_role("button", name="Operator lane").click()
     cobot, operator = _box(page, "c"), _box(page, "o")
+    # A cobot task must name its program (a task-config error otherwise): the lane's default.
+    page.mouse.click(cobot["x"] + 10, cobot["y"] + cobot["height"] / 2)  # the lane's name strip
+    expect(page.locator('.djs-element.selected[data-element-id="c"]')).to_have_count(1)
+    program = page.get_by_role("region", name="Properties").get_by_label("Default program")
+    program.fill("Synchronized_SpotTaping")
+    program.press("Tab")
 
     # The cobot's line: p1 (with the case's token), a split, pick, place and fix the insert.
     _drop(page, "Place", cobot["x"] + 100, cobot["y"] + cobot["height"] / 2)
@@ -257,6 +263,10 @@ def _assert_is_the_thesis_assembly(document: dict[str, Any]) -> None:
     (process,) = document["processes"]
     (expected,) = thesis["processes"]
     assert {a["id"]: a["type"] for a in document["actors"]} == {"c": "cobot", "o": "operator"}
+    assert {a["id"]: a.get("program") for a in document["actors"]} == {
+        "c": "Synchronized_SpotTaping",
+        "o": None,
+    }
     assert sorted(process["actors"]) == ["c", "o"]
     assert sorted(p["id"] for p in process["places"]) == sorted(p["id"] for p in expected["places"])
     assert {p["id"]: p.get("tokens") for p in process["places"] if p.get("tokens")} == {"p1": 1}

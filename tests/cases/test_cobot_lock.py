@@ -49,7 +49,10 @@ def _one_cobot_task() -> dict[str, Any]:
     return {
         "format": "hrc-pattern/1",
         "name": "pick beside loading",
-        "actors": [{"id": "c", "type": "cobot"}, {"id": "o", "type": "operator"}],
+        "actors": [
+            {"id": "c", "type": "cobot", "program": PROGRAM},
+            {"id": "o", "type": "operator"},
+        ],
         "processes": [
             {
                 "id": "N",

@@ -48,26 +48,26 @@ def process(
     }
 
 
+PROGRAM = "Coexistence_PickAndPlace"
+
+
 def document(
     *processes: dict[str, Any],
     constraints: list[tuple[str, str, str]] = (),  # type: ignore[assignment]
     actors: dict[str, str] | None = None,
     declared: str | None = None,
 ) -> dict[str, Any]:
-    """A document; actors default to every performer, `c…` a cobot and anything else an operator."""
+    """A document; actors default to every performer, `c…` a cobot and anything else an operator.
+
+    Each cobot runs PROGRAM (a cobot task must name its program to be checked clean)."""
     if actors is None:
         names = sorted({a for p in processes for a in p["actors"]})
         actors = {a: "cobot" if a.startswith("c") else "operator" for a in names}
     data: dict[str, Any] = {
         "format": "hrc-pattern/1",
         "name": "test",
-        # A cobot's program: a cobot task that names none is a task-config error.
         "actors": [
-            {
-                "id": a,
-                "type": t,
-                **({"program": "Coexistence_PickAndPlace"} if t == "cobot" else {}),
-            }
+            {"id": a, "type": t, **({"program": PROGRAM} if t == "cobot" else {})}
             for a, t in actors.items()
         ],
         "processes": list(processes),

@@ -22,15 +22,20 @@ from tests.engine.builders import document, process, two_lanes
 
 Doc = dict[str, Any]
 
+PROGRAM = "Coexistence_PickAndPlace"
+
 
 def _doc(**extra: Any) -> Doc:
     """A cobot task tc1, an operator task to1, and a silent transition x1 between them.
 
     `extra` maps a transition id to the keys to add to it, e.g. `tc1={"task": {...}}`.
+    The cobot actor c runs PROGRAM.
     """
     data = document(
         process("N", "p1 tc1 p2 x1 p3 to1 p4", performers={"tc1": "c", "to1": "o"}),
     )
+    [cobot] = [actor for actor in data["actors"] if actor["id"] == "c"]
+    cobot["program"] = PROGRAM
     for transition in data["processes"][0]["transitions"]:
         transition.update(extra.get(transition["id"], {}))
     return data
@@ -63,33 +68,31 @@ def _refused(task: object, task_id: str = "tc1") -> str:
 # Defaults -------------------------------------------------------------------------
 
 
-def test_a_cobot_task_that_names_no_program_is_refused_not_run_with_a_default() -> None:
-    data = _doc()
-    del data["actors"][0]["program"]
-
-    with pytest.raises(ConfigError, match=r"^tc1: the cobot task names no program"):
-        _config("tc1", data)
-    assert [(i.code, i.elements) for i in config_issues(read_pattern(data))] == [
-        ("task-config", ("tc1",))
-    ]
-
-
-def test_a_cobot_task_without_config_runs_step_1_of_its_actors_program_with_the_defaults() -> None:
+def test_a_cobot_task_without_config_runs_step_1_of_its_actors_program_with_defaults() -> None:
     config = _config("tc1", _doc())
 
     assert config.kind == "step"
     assert config.step is not None
-    assert (config.step.program, config.step.number, config.step.workspace) == (
-        "Coexistence_PickAndPlace",
-        1,
-        0,
-    )
+    assert (config.step.program, config.step.number, config.step.workspace) == (PROGRAM, 1, 0)
     assert list(config.step.poses) == []
     assert (config.timeout, config.retries, config.outputs) == (
         DEFAULT_TIMEOUT,
         DEFAULT_RETRIES,
         None,
     )
+
+
+@pytest.mark.parametrize("task", [None, {"step": {"number": 2}}])
+def test_a_cobot_task_that_names_no_program_is_refused_when_checked(task: object) -> None:
+    data = _doc(tc1={"task": task} if task is not None else {})
+    for actor in data["actors"]:
+        actor.pop("program", None)
+
+    issues = [i for i in check_document(data).errors if i.code == "task-config"]
+
+    assert [i.elements for i in issues] == [("tc1",)]
+    assert issues[0].message.startswith("tc1: the cobot task names no program")
+    assert "'c'" in issues[0].message
 
 
 def test_a_cobot_task_without_config_runs_step_1_of_its_actors_program() -> None:

@@ -114,6 +114,7 @@ export const EVENT_NAMES: Record<string, string> = {
   "transition-fired": "Transition fired",
   "message-received": "Message received",
   "step-retry": "Step will be retried",
+  "step-failed": "Step failed",
   "incident-opened": "Incident opened",
   "incident-resolved": "Incident resolved",
 };

@@ -65,52 +65,10 @@ class CobotNotReady(DriverError):
     """The cobot is not powered, not running its program, or in a mode where it cannot move."""
 
 
-class CobotStarting(DriverError):
-    """The cobot is powering on or booting, as a person asked: wait for it and try again."""
+class CobotStarting(CobotNotReady):
+    """The cobot is booting or powering on: it gets to Idle or Running by itself, so retry."""
 
     transient = True
-
-
-# What a person does about each robot mode in which a cobot cannot take a step. hrc never
-# powers a cobot on or releases its brakes by itself: people decide that at the cell.
-_MODE_REMEDIES: Mapping[str, str] = {
-    urua.ROBOT_MODE_POWER_OFF: "is powered off: power it on at the pendant or from its page",
-    urua.ROBOT_MODE_IDLE: (
-        "is powered on with its brakes applied (Idle): release the brakes at the pendant or "
-        "from its page"
-    ),
-    "Confirm Safety": "waits for its safety configuration to be confirmed at the pendant",
-    "Backdrive": "is in backdrive: a person at the pendant must finish it and release the brakes",
-    "Updating Firmware": "is updating its firmware: wait until it is done, then power it on",
-    "No Controller": "has no controller running: start the controller at the cell",
-    "Disconnected": "has no controller connected: check the controller at the cell",
-}
-# Modes a cobot passes through on its way to Running, once a person has powered it on.
-_STARTING_MODES = frozenset({"Power On", "Booting"})
-
-
-def cannot_move(name: str, state: Mapping[str, Any], page: str = "") -> DriverError | None:
-    """Why the cobot in `state` cannot take a step, saying what a person does; None when it can.
-
-    `page` is where the cobot's page is (appended to "from its page"). A protective or
-    emergency stop is never cleared by software: the message says a person clears it.
-    """
-    safety = str(state.get("SafetyMode") or "")
-    mode = str(state.get("RobotMode") or "")
-    where = f" ({page})" if page else ""
-    if safety and safety not in urua.SAFETY_MODES_THAT_MOVE:
-        stop = safety.removeprefix("SAFETY_MODE_").replace("_", " ").lower()
-        return CobotStopped(
-            f"{name} is in a {stop}: a person must check the cell and clear it at the teach "
-            "pendant; hrc never clears it.",
-            state=state,
-        )
-    if mode == urua.ROBOT_MODE_RUNNING:
-        return None
-    if mode in _STARTING_MODES:
-        return CobotStarting(f"{name} is starting ({mode}); the step waits for it.", state=state)
-    remedy = _MODE_REMEDIES.get(mode, f"is in robot mode {mode!r}, not Running")
-    return CobotNotReady(f"{name} {remedy}{where if 'its page' in remedy else ''}.", state=state)
 
 
 @dataclasses.dataclass(frozen=True)

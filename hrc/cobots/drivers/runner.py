@@ -17,6 +17,7 @@ from typing import Any, TypeVar
 
 from django.conf import settings
 
+from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import CobotUnreachable, DriverError, StepCommand, StepResult
 from hrc.cobots.drivers.opcua.driver import ClientSecurity, OpcUaDriver
 from hrc.cobots.models import Cobot
@@ -135,4 +136,6 @@ def driver_for_cobot(cobot: Cobot, **options: Any) -> SyncDriver:
     if credentials is not None:
         username, password = credentials
         security = ClientSecurity(settings.HRC_PKI_DIR, username, password)
-    return driver_for(cobot.name, cobot.endpoint, security, **options)
+    return driver_for(
+        cobot.name, cobot.endpoint, security, page=readiness.page_of(cobot.pk), **options
+    )

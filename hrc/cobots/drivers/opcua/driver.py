@@ -28,6 +28,7 @@ from asyncua import Client, Node, ua
 from asyncua.common.methods import call_method_full
 
 from hrc.cobots import urua
+from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
     NO_FENCE,
     CobotBusy,
@@ -41,7 +42,6 @@ from hrc.cobots.drivers.base import (
     StepCommand,
     StepResult,
     StepTimeout,
-    cannot_move,
 )
 from hrc.cobots.pki import PkiError, check_gateway_certificate, secure_client
 
@@ -121,8 +121,11 @@ class OpcUaDriver(CobotDriver):
         release_timeout: float = 10.0,
         publishing_interval: float = 0.0,
         backoff: tuple[float, float] = (0.05, 5.0),
+        page: str = "",
     ) -> None:
         self.name = name
+        # The cobot's page in hrc, named in what a person must do (readiness.not_ready).
+        self.page = page
         self.endpoint = endpoint
         self.security = security
         self.connect_timeout = connect_timeout
@@ -440,10 +443,13 @@ class OpcUaDriver(CobotDriver):
 
     def _unready(self, fence: Any) -> DriverError | None:
         """Why the cached state says the cobot cannot take a step now; None when it can."""
-        program = self.cache[urua.STATE_PROGRAM_STATE]
-        problem = cannot_move(self.name, self._state_from_cache())
+        problem = readiness.not_ready(
+            self.name, self._state_from_cache(), page=self.page, endpoint=self.endpoint
+        )
         if problem is not None:
-            return type(problem)(f"{problem} Step {fence} was not sent.", state=problem.state)
+            # The same error, saying the step stayed here: a retry sends it with its token.
+            return type(problem)(f"{problem} Step {fence} was not sent.", state=self.cache)
+        program = self.cache[urua.STATE_PROGRAM_STATE]
         if program != urua.PROGRAM_PLAYING:
             return CobotNotReady(
                 f"{self.name}'s program is {program!r}, not Playing: select and start the step "

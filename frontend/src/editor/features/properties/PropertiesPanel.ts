@@ -112,7 +112,7 @@ export default class PropertiesPanel {
     field(this.panel, { label: "Name", value: String(object.data.label ?? ""), commit: (text) => this.modeling.updateLabel(shape, text) });
     select(this.panel, "Kind", object.data.type, [["operator", "operator (a person)"], ["cobot", "cobot"]], (type) => this.modeling.updateData(shape, { type }));
     if (object.data.type === "cobot") {
-      field(this.panel, { label: "Default program", value: String(object.data.program ?? ""), placeholder: "Coexistence_PickAndPlace", commit: (text) => this.modeling.updateData(shape, { program: text.trim() || undefined }) });
+      field(this.panel, { label: "Default program", value: String(object.data.program ?? ""), placeholder: "needed unless each step names one", commit: (text) => this.modeling.updateData(shape, { program: text.trim() || undefined }) });
     }
     const root = objectOf(this.canvas.getRootElement() as Shape) as RootObject;
     select(this.panel, "Net (process)", object.process ?? "", root.processes.map((p): [string, string] => [String(p.id), String(p.id)]), (process) => this.modeling.updateData(shape, {}, { process }));
