@@ -9,7 +9,6 @@ cell unlocks it, the engineer presses Retry, and this process's job runner
 """
 
 import re
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -25,6 +24,7 @@ from hrc.cases.simulation import Simulation
 from hrc.organisations.choices import Role
 from tests import factories
 from tests.cases.patterns import cobot_chain, shared_space
+from tests.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
@@ -36,16 +36,6 @@ LIVE = 10_000
 # The cobot's steps run this many times slower until a test has done what must happen
 # mid-step: a ~1 s pick could otherwise end first on a loaded machine (signing in takes time).
 SLOWDOWN = "4"
-
-
-def _until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError("condition not reached in time")
 
 
 def _card(page: Page, incident: Incident) -> Any:
@@ -224,12 +214,12 @@ def test_an_engineer_retries_a_step_after_a_protective_stop_and_sees_the_case_fi
         with simulation.running(operators=False):
             [case_id] = simulation.start_cases(1)
             case = Case.objects.get(pk=case_id)
-            load = _until(lambda: case.work_items.filter(task="to1").first())
+            load = until(lambda: case.work_items.filter(task="to1").first())
             services.start_work_item(load, user=simulation.users["o"])
             services.complete_work_item(load, user=simulation.users["o"])
-            _until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
+            until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
             cobot.call("Simulator/InjectFault", "protective-stop", "")
-            incident = _until(lambda: Incident.objects.filter(case=case).first())
+            incident = until(lambda: Incident.objects.filter(case=case).first())
             cobot.call("Simulator/ClearFault")  # the slowdown; the stop stays for a person
 
             sign_in(page, engineer)
@@ -243,7 +233,7 @@ def test_an_engineer_retries_a_step_after_a_protective_stop_and_sees_the_case_fi
             screenshot(page, "supervisor-protective-stop")
 
             # The person at the cell clears the stop (hrc never does); then the engineer retries.
-            _until(lambda: _unlocked(cobot))
+            until(lambda: _unlocked(cobot))
             card.get_by_role("button", name="Retry").click()
 
             expect(card.get_by_role("status")).to_have_text("Resolved: retry by eve-engineer")
@@ -266,15 +256,15 @@ def test_an_interruption_shows_while_an_operator_works_in_the_shared_area(
         with simulation.running(operators=False):
             [case_id] = simulation.start_cases(1)
             case = Case.objects.get(pk=case_id)
-            load = _until(lambda: case.work_items.filter(task="to1").first())
+            load = until(lambda: case.work_items.filter(task="to1").first())
             services.start_work_item(load, user=operator)
             services.complete_work_item(load, user=operator)
-            _until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
+            until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
             sign_in(page, engineer)
             page.goto(f"{live_url}/cases/{case_id}/")
             expect(page.locator("#interruptions")).to_contain_text("No interruptions.")
 
-            inspect = _until(lambda: case.work_items.filter(task="to2").first())
+            inspect = until(lambda: case.work_items.filter(task="to2").first())
             services.start_work_item(inspect, user=operator)
             interruptions = page.locator("#interruptions")
             expect(interruptions).to_contain_text("(ongoing)", timeout=LIVE)

@@ -5,7 +5,6 @@ and its socket. Screenshots of each state go to var/screenshots/."""
 from __future__ import annotations
 
 import re
-import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +27,7 @@ from hrc.patterns.models import PatternVersion
 from tests import factories
 from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.live.server import LiveServer, MonitorProcess
+from tests.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
@@ -75,16 +75,6 @@ def _sign_in(page: Page, url: str, user: User) -> None:
     page.get_by_label("Password").fill(factories.PASSWORD)
     page.get_by_role("button", name="Sign in").click()
     page.wait_for_url(f"{url}/")
-
-
-def _until(condition: Callable[[], Any], timeout: float = 60.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError("condition not reached in time")
 
 
 # The cell: a gateway, a worker, the monitor, a server, all on a private broker ----------------
@@ -211,7 +201,7 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
         "second pick", timeout=LIVE_MS
     )
     screenshot(page, "tablet-cobot-next-step")
-    _until(lambda: Case.objects.get(pk=case.pk).status == CaseStatus.COMPLETED)
+    until(lambda: Case.objects.get(pk=case.pk).status == CaseStatus.COMPLETED, timeout=60)
     item = WorkItem.objects.get(case=case, task="to1")
     assert item.result == {"parts": 12, "clean": True}
     assert item.completed_by == operator
@@ -230,7 +220,7 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     # STOP pauses the cell; only a confirmed resume restarts it.
     page.get_by_role("button", name="STOP every cobot of the cell").click()
     expect(page.locator(".stop-banner")).to_contain_text(f"STOPPED by {operator.username}")
-    _until(lambda: arm.read(urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PAUSED)
+    until(lambda: arm.read(urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PAUSED)
     page.get_by_role("button", name="Resume…").click()
     confirm = page.locator(".confirm-dialog")
     expect(confirm).to_be_visible()
@@ -241,7 +231,7 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     page.get_by_role("button", name="Resume…").click()
     confirm.get_by_role("button", name="Resume the cell").click()
     expect(page.locator(".stop-banner")).to_be_hidden(timeout=LIVE_MS)
-    _until(lambda: arm.read(urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PLAYING)
+    until(lambda: arm.read(urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PLAYING)
 
 
 # Losing the socket ------------------------------------------------------------------------

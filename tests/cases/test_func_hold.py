@@ -10,7 +10,6 @@ waiting case's step.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -30,6 +29,7 @@ from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PICK, func_hold
+from tests.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
@@ -140,18 +140,8 @@ def test_a_cobot_nobody_uses_is_not_in_use(organisation: Organisation) -> None:
     assert cobot_in_use(factories.make_cobot(organisation).pk) == ""
 
 
-def _until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.01)
-    raise AssertionError("condition not reached in time")
-
-
 def _screw(case_id: int, user: User) -> None:
-    screw = _until(lambda: _offered(case_id, "to1"))
+    screw = until(lambda: _offered(case_id, "to1"))
     services.start_work_item(screw, user=user)
     services.complete_work_item(screw, user=user)
 
@@ -169,7 +159,7 @@ def test_on_a_gateway_the_other_cases_step_starts_once_the_hold_ends_and_not_bef
         dispatch.run_inline(pool),  # the doorbells run jobs on these threads; no sweeper
     ):
         holder, waiter = simulation.start_cases(2)
-        _until(lambda: Job.objects.filter(case_id=holder, state=JobState.SUCCEEDED).exists())
+        until(lambda: Job.objects.filter(case_id=holder, state=JobState.SUCCEEDED).exists())
         time.sleep(1.0)  # ample for a doorbell to start the other case's step (a pick is 0.1 s)
 
         waiting = Job.objects.get(case_id=waiter)
@@ -179,10 +169,10 @@ def test_on_a_gateway_the_other_cases_step_starts_once_the_hold_ends_and_not_bef
 
         _screw(holder, simulation.users["o"])
         released = time.monotonic()
-        _until(lambda: Job.objects.filter(pk=waiting.pk, started_at__isnull=False).exists())
+        until(lambda: Job.objects.filter(pk=waiting.pk, started_at__isnull=False).exists())
         latency = time.monotonic() - released
         _screw(waiter, simulation.users["o"])
-        _until(lambda: Case.objects.filter(pk=waiter, status=CaseStatus.COMPLETED).exists())
+        until(lambda: Case.objects.filter(pk=waiter, status=CaseStatus.COMPLETED).exists())
         executions, _ = simulation.executed_steps("c")
 
     assert latency < 2.0, f"the waiting step started {latency:.2f} s after the hold ended"

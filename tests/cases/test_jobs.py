@@ -4,7 +4,7 @@ device calls with their outputs, interruptions for shared space, and failures th
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -16,18 +16,9 @@ from hrc.cases.models import Case, Incident, Interruption, Job, WorkItem
 from hrc.cases.simulation import Simulation
 from hrc.cobots import urua
 from tests.cases.patterns import scan_until_found, shared_space, unusable_outputs
+from tests.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
-
-
-def until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.02)
-    raise AssertionError("condition not reached in time")
 
 
 def _operator_task(case: Case, task: str) -> WorkItem:
