@@ -28,6 +28,8 @@ Document = dict[str, Any]
 
 FAMILIES: tuple[str, ...] = ("blocks", "wide-2", "wide-3", "choices-3", "lanes", "lanes-dead")
 SIZES: tuple[int, ...] = (20, 100, 200)
+# The program the generated cobots' tasks run: step 1 of pick-and-place moves home.
+PROGRAM = "Coexistence_PickAndPlace"
 
 # Tasks per branch of a `blocks` block before the remainder is spread: short
 # chains keep the state space linear while each block still interleaves.
@@ -91,13 +93,14 @@ def _spread(total: int, parts: int) -> list[int]:
 
 
 def _actors(count: int) -> list[dict[str, str]]:
-    """`count` actors alternating operator and cobot, so each parallel branch has its own."""
+    """`count` actors alternating operator and cobot, so each parallel branch has its own;
+    each cobot names the program its tasks run (a cobot task without one does not check)."""
     actors = []
     for index in range(count):
-        kind = "operator" if index % 2 == 0 else "cobot"
-        actors.append(
-            {"id": f"{'op' if kind == 'operator' else 'cobot'}{index // 2 + 1}", "type": kind}
-        )
+        if index % 2 == 0:
+            actors.append({"id": f"op{index // 2 + 1}", "type": "operator"})
+        else:
+            actors.append({"id": f"cobot{index // 2 + 1}", "type": "cobot", "program": PROGRAM})
     return actors
 
 
