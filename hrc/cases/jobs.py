@@ -51,7 +51,7 @@ from hrc.cobots import urua
 from hrc.cobots.control import running_commands
 from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
-    CobotNotReady,
+    CobotPaused,
     CommandRefused,
     DriverError,
     Fence,
@@ -301,11 +301,17 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     problem = readiness.not_ready(driver.name, state, page=readiness.page_of(cobot_id))
     if problem is not None:
         raise problem
-    # A STOP from a tablet may have paused the program since the lease: playing it
-    # again here would undo the STOP.
+    # A STOP from a tablet, or an operator entering a shared area, may have paused the
+    # program since the lease: playing it again here would undo the pause.
     if Cobot.objects.filter(pk=cobot_id, stopped_at__isnull=False).exists():
-        raise CobotNotReady(
-            f"{driver.name}'s cell was stopped from a tablet; resume it there, then retry.",
+        raise CobotPaused(
+            f"{driver.name}'s cell was stopped from a tablet; the step waits until it is resumed.",
+            state=state,
+        )
+    if _unsettled_interruptions(Cobot(pk=cobot_id)).exists():
+        raise CobotPaused(
+            f"{driver.name} is paused for an operator in a shared area; the step waits until "
+            "the operator's task ends.",
             state=state,
         )
     if _loaded(state) != program:
@@ -381,7 +387,17 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
             return
         job.last_error, job.accepted_at = str(error), accepted_at
         item = job.work_item
-        if error.transient and job.retries_left > 0:
+        if isinstance(error, CobotPaused):
+            # Not sent, and nothing a retry would change: back in the queue, which waits for
+            # the pause to end (an interruption settled, a STOP resumed) before it leases again.
+            job.state, job.next_try_at = JobState.QUEUED, timezone.now()
+            job.save()
+            services.record_event(
+                case, EventType.STEP_RETRY, item=item,
+                detail={"error": str(error), "in_seconds": 0, "retries_left": job.retries_left},
+            )  # fmt: skip
+            dispatch.send_on_commit("run_job", job.pk)
+        elif error.transient and job.retries_left > 0:
             job.retries_left -= 1
             delay = _backoff(case_net(case.version).tasks[item.task].retries - job.retries_left)
             job.state, job.next_try_at = (

@@ -8,14 +8,15 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from django.contrib.auth.models import User
 from django.utils import timezone
 
 from hrc.cases import jobs
 from hrc.cases.choices import CaseStatus, IncidentKind, JobState
-from hrc.cases.models import Case, Incident, Job
+from hrc.cases.models import Case, Incident, Interruption, Job
 from hrc.cases.simulation import Simulation
 from hrc.cobots import urua
-from hrc.cobots.drivers.base import CobotNotReady
+from hrc.cobots.drivers.base import CobotNotReady, CobotPaused
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.organisations.choices import Role
@@ -50,6 +51,39 @@ def test_a_program_paused_by_a_cell_stop_is_not_played_again(
     with pytest.raises(CobotNotReady, match="stopped from a tablet"):
         jobs._prepare(driver, cobot.pk, PROGRAM, timeout=10)
     assert driver.state()["ProgramState"] == urua.PROGRAM_PAUSED
+
+
+def test_a_program_paused_for_an_operator_in_a_shared_area_is_not_played_and_the_step_waits(
+    driver: SyncDriver, organisation: Organisation, engineer: User, operator: User
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot1")
+    version = factories.make_version(organisation, published_by=engineer)
+    case = factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
+    job = Job.objects.get(case=case)
+    # The operator entered the shared area just after the job was leased: the cobot is paused.
+    Interruption.objects.create(
+        case=case, work_item=job.work_item, operator_work_item=factories.open_work_item(case, "tc1"),
+        cobot=cobot, mode="pause", paused_at=timezone.now(),
+    )  # fmt: skip
+    driver.call("PauseProgram")
+
+    with pytest.raises(CobotPaused, match="paused for an operator in a shared area") as paused:
+        jobs._prepare(driver, cobot.pk, PROGRAM, timeout=10)
+    assert driver.state()["ProgramState"] == urua.PROGRAM_PAUSED  # not played over the operator
+
+    lease = jobs.lease_next_job(cobot.pk)
+    assert lease is None  # the queue waits for the interruption, so lease the job as it was
+    Job.objects.filter(pk=job.pk).update(state=JobState.RUNNING, lease=1)
+    retries = job.retries_left
+    jobs.fail_job(
+        jobs.Lease(
+            job.pk, case.pk, 1, job.attempt, job.kind, job.command, job.timeout, cobot, False
+        ),
+        paused.value,
+    )
+    job.refresh_from_db()
+    assert (job.state, job.retries_left) == (JobState.QUEUED, retries)  # waits, retries spared
+    assert not Incident.objects.filter(case=case).exists()
 
 
 def test_a_paused_program_of_a_running_cell_is_played_for_the_step(

@@ -65,6 +65,12 @@ class CobotNotReady(DriverError):
     """The cobot is not powered, not running its program, or in a mode where it cannot move."""
 
 
+class CobotPaused(CobotNotReady):
+    """The cobot's program is paused (for an operator in a shared area, a cell's STOP, or at the
+    pendant) before the step was sent: the step waits in its queue for the resume, retries spared.
+    """
+
+
 class CobotStarting(CobotNotReady):
     """The cobot is booting or powering on: it gets to Idle or Running by itself, so retry."""
 

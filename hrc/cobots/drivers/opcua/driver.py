@@ -34,6 +34,7 @@ from hrc.cobots.drivers.base import (
     CobotBusy,
     CobotDriver,
     CobotNotReady,
+    CobotPaused,
     CobotStopped,
     CobotUnreachable,
     CommandRefused,
@@ -46,6 +47,9 @@ from hrc.cobots.drivers.base import (
 from hrc.cobots.pki import PkiError, check_gateway_certificate, secure_client
 
 logger = logging.getLogger(__name__)
+
+# Program states a pause leaves behind; a resume (StartProgram) plays on from them.
+PAUSED = frozenset({"Pausing", urua.PROGRAM_PAUSED})
 
 SESSION_TIMEOUT_MS = 600_000
 
@@ -450,6 +454,12 @@ class OpcUaDriver(CobotDriver):
             # The same error, saying the step stayed here: a retry sends it with its token.
             return type(problem)(f"{problem} Step {fence} was not sent.", state=self.cache)
         program = self.cache[urua.STATE_PROGRAM_STATE]
+        if program in PAUSED:
+            return CobotPaused(
+                f"{self.name}'s program is {program!r}; step {fence} was not sent and waits for "
+                "the program to be resumed.",
+                state=self.cache,
+            )
         if program != urua.PROGRAM_PLAYING:
             return CobotNotReady(
                 f"{self.name}'s program is {program!r}, not Playing: select and start the step "
