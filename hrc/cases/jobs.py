@@ -193,7 +193,9 @@ def _lease_if_ready(
         return None
     item = job.work_item
     net = case_net(case.version)
-    waiting = _why_held(cobot, case) if held else ""
+    # Asked again under the locks: the hold may have ended since the queue was read (it ends
+    # in a transaction of its own, then rings the doorbell).
+    waiting = why_held(cobot.pk, other_than=case.pk) if held else ""
     waiting = waiting or _why_waiting(case, net, item)
     if not waiting and item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
@@ -229,15 +231,6 @@ def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
     return case, job
 
 
-def _why_held(cobot: Cobot, case: Case) -> str:
-    """Why another case's func hold keeps the cobot from `case`; "" when the hold has ended
-    since the queue was read (it ends in a transaction of its own, then rings the doorbell)."""
-    holding = (
-        holding_work_items().filter(cobot=cobot).exclude(case=case).select_related("case__version")
-    ).first()
-    return why_held(holding) if holding is not None else ""
-
-
 def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     """Why a cobot task must not start now although the marking allows it; "" when it may."""
     for pair in net.space_pairs:
@@ -251,7 +244,8 @@ def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     return ""
 
 
-def _unsettled_interruptions(cobot: Cobot) -> QuerySet[Interruption]:
+def _unsettled_interruptions(cobot: Cobot | int) -> QuerySet[Interruption]:
+    """The interruptions that keep the cobot (or the cobot of that id) paused or slowed."""
     return Interruption.objects.filter(cobot=cobot).filter(
         Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
@@ -282,9 +276,10 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     """Loads and plays the step's program when the cobot is idle in another one.
 
     Never powers the arm on, releases its brakes or clears a stop: a cobot that
-    is not running (powered, brakes released), or whose cell a tablet stopped
-    after this job was leased, raises the error that names its state and what
-    a person does (readiness.not_ready); one on its way up is retried.
+    is not running (powered, brakes released) raises the error that names its
+    state and what a person does (readiness.not_ready); one on its way up is
+    retried. Nor does it play a program paused since the lease (a tablet's STOP,
+    an operator in a shared area): CobotPaused puts the step back in the queue.
     """
 
     def ready(state: dict[str, Any]) -> bool:
@@ -308,7 +303,7 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
             f"{driver.name}'s cell was stopped from a tablet; the step waits until it is resumed.",
             state=state,
         )
-    if _unsettled_interruptions(Cobot(pk=cobot_id)).exists():
+    if _unsettled_interruptions(cobot_id).exists():
         raise CobotPaused(
             f"{driver.name} is paused for an operator in a shared area; the step waits until "
             "the operator's task ends.",

@@ -185,8 +185,15 @@ def holding_work_items() -> QuerySet[WorkItem]:
     ).exclude(Exists(undecided))
 
 
-def why_held(item: WorkItem) -> str:
-    """'holding for: <supported task>, case N' for a holding work item (its case read along)."""
+def why_held(cobot_id: int, *, other_than: int | None = None) -> str:
+    """'holding for: <supported task>, case N' when a func hold reserves the cobot (for a case
+    other than `other_than`, given); "" when none does."""
+    holding = holding_work_items().filter(cobot_id=cobot_id)
+    if other_than is not None:
+        holding = holding.exclude(case_id=other_than)
+    item = holding.select_related("case__version").first()
+    if item is None:
+        return ""
     case = item.case
     net = case_net(case.version)
     tasks = net.holding_for(item.task, Marking(case.marking)) or net.holding_for(item.task)
@@ -210,8 +217,7 @@ def cobot_in_use(cobot_id: int) -> str:
         label, number = running.work_item.label, (running.command or {}).get("number")
         what = f"step {number} of {label}" if running.kind == WorkItemKind.STEP else label
         return f"{what}, case {running.case_id} is running"
-    held = holding_work_items().filter(cobot_id=cobot_id).select_related("case__version").first()
-    return why_held(held) if held is not None else ""
+    return why_held(cobot_id)
 
 
 def incidents_visible_to(user: AnyUser, *, open_only: bool = True) -> QuerySet[Incident]:
