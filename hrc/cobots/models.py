@@ -8,8 +8,9 @@ from django.conf import settings
 from django.db import models
 
 from hrc.cobots.choices import CommandOutcome, ControlCommand, DriverKind
-from hrc.cobots.validators import validate_cell, validate_credentials_source, validate_endpoint
+from hrc.cobots.validators import validate_credentials_source, validate_endpoint
 from hrc.organisations.models import Organisation
+from hrc.organisations.validators import validate_cell
 
 
 class Cobot(models.Model):
@@ -49,8 +50,9 @@ class Cobot(models.Model):
         default="",
         validators=[validate_cell],
         help_text=(
-            "The work cell the cobot stands in (letters, digits, - and _); a tablet at /tablet/<cell>/ "
-            "shows and stops its cobots. Empty: the organisation's whole floor (/tablet/)."
+            "The work cell the cobot stands in (letters, digits, - and _), registered as one of the "
+            "organisation's cells; that cell's tablet shows and stops its cobots. Empty: the "
+            "organisation's whole floor."
         ),
     )
     stopped_at = models.DateTimeField(

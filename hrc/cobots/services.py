@@ -7,6 +7,7 @@ from django.db import IntegrityError, transaction
 
 from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
+from hrc.organisations.services import ensure_cell
 
 # The fields a caller may set; organisation is fixed once the cobot exists.
 EDITABLE_FIELDS = ("name", "driver", "endpoint", "credentials_source", "cell", "is_active")
@@ -22,6 +23,7 @@ def create_cobot(organisation: Organisation, **fields: Any) -> Cobot:
     cobot.full_clean()
     try:
         with transaction.atomic():
+            _register_cell(cobot)
             cobot.save()
     except IntegrityError:
         # Another request took the name between full_clean and save.
@@ -37,13 +39,22 @@ def update_cobot(cobot: Cobot, **changes: Any) -> Cobot:
     for field, value in changes.items():
         setattr(cobot, field, value)
     cobot.full_clean()
-    cobot.save(update_fields=[*changes, "updated_at"])
+    with transaction.atomic():
+        _register_cell(cobot)
+        cobot.save(update_fields=[*changes, "updated_at"])
     return cobot
 
 
 def delete_cobot(cobot: Cobot) -> None:
     """Forgets the cobot. To keep its history, set is_active=False instead."""
     cobot.delete()
+
+
+def _register_cell(cobot: Cobot) -> None:
+    # A cobot's cell is one of the organisation's cells, so the cell's tablet and
+    # the administration's list of cells know it.
+    if cobot.cell:
+        ensure_cell(cobot.organisation, cobot.cell)
 
 
 def _reject_unknown(fields: dict[str, Any]) -> None:

@@ -55,14 +55,3 @@ def validate_credentials_source(value: str) -> None:
         "The credentials source must be 'none', 'env:VARIABLE_NAME' or 'file:/absolute/path'; "
         "it says where the secret is, never the secret itself."
     )
-
-
-_CELL = re.compile(r"[A-Za-z0-9_-]{0,50}")
-
-
-def validate_cell(value: str) -> None:
-    """A cell name is part of URLs and channel-layer group names: letters, digits, - and _ only."""
-    if not _CELL.fullmatch(value):
-        raise ValidationError(
-            f"{value!r} is not a cell name: use up to 50 letters, digits, - and _ (no spaces)."
-        )

@@ -24,10 +24,10 @@ from channels.db import database_sync_to_async
 from channels.generic.websocket import AsyncJsonWebsocketConsumer
 from channels.layers import InMemoryChannelLayer
 
-from hrc.cobots.validators import validate_cell
 from hrc.live import broadcast, selectors
 from hrc.live.events import CobotStateData, LiveEvent
 from hrc.live.selectors import Access
+from hrc.organisations.validators import validate_cell
 
 # Seconds between two reads of the connected sockets' memberships.
 RECHECK_SECONDS = 5.0

@@ -8,6 +8,7 @@ from django.conf import settings
 from django.db import models
 
 from hrc.organisations.choices import Role
+from hrc.organisations.validators import validate_cell
 
 
 class Organisation(models.Model):
@@ -100,3 +101,35 @@ class Team(models.Model):
 
     def __str__(self) -> str:
         return f"{self.name} ({self.organisation})"
+
+
+class Cell(models.Model):
+    """A work cell on the floor: where cobots stand and a tablet shows them (/tablet/<name>/)."""
+
+    organisation = models.ForeignKey(
+        Organisation,
+        on_delete=models.CASCADE,
+        related_name="cells",
+        help_text="The organisation whose floor the cell is on.",
+    )
+    name = models.CharField(
+        max_length=50,
+        validators=[validate_cell],
+        help_text="The cell's name, unique in its organisation: letters, digits, - and _ (it is part of the tablet's address).",
+    )
+    description = models.CharField(
+        max_length=300, blank=True, help_text="Where the cell is and what is done there."
+    )
+
+    class Meta:
+        ordering = ["organisation__name", "name"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["organisation", "name"],
+                name="cell_name_unique_in_organisation",
+                violation_error_message="The organisation already has a cell of this name.",
+            )
+        ]
+
+    def __str__(self) -> str:
+        return self.name

@@ -7,7 +7,7 @@ from django.contrib.auth.models import AbstractBaseUser, AnonymousUser
 from django.db.models import QuerySet
 
 from hrc.organisations.choices import WRITER_ROLES, Role
-from hrc.organisations.models import Membership, Organisation
+from hrc.organisations.models import Cell, Membership, Organisation
 
 AnyUser = AbstractBaseUser | AnonymousUser
 
@@ -45,3 +45,8 @@ def role_in(user: AnyUser, organisation_id: int) -> Role | None:
 def may_write_in(user: AnyUser, organisation_id: int) -> bool:
     """Whether the user may change the organisation's models and cobots."""
     return role_in(user, organisation_id) in WRITER_ROLES
+
+
+def cells_of(organisation_id: int) -> QuerySet[Cell]:
+    """The organisation's cells by name."""
+    return Cell.objects.filter(organisation_id=organisation_id).order_by("name")

@@ -13,7 +13,7 @@ from django.core.exceptions import ValidationError
 from django.db import transaction
 
 from hrc.organisations.choices import Role
-from hrc.organisations.models import Membership, Organisation, Team
+from hrc.organisations.models import Cell, Membership, Organisation, Team
 
 
 def create_organisation(*, name: str, slug: str) -> Organisation:
@@ -95,6 +95,16 @@ def set_team_members(team: Team, memberships: Iterable[Membership]) -> Team:
 def delete_team(team: Team) -> None:
     """Dissolves the team; its members stay in the organisation."""
     team.delete()
+
+
+def ensure_cell(organisation: Organisation, name: str) -> Cell:
+    """The organisation's cell of that name, registered now if it was not yet (a cobot placed there)."""
+    cell = Cell.objects.filter(organisation=organisation, name=name).first()
+    if cell is None:
+        cell = Cell(organisation=organisation, name=name)
+        cell.full_clean()
+        cell, _ = Cell.objects.get_or_create(organisation=organisation, name=name)
+    return cell
 
 
 @transaction.atomic

@@ -87,6 +87,30 @@ def screenshot() -> Callable[[Page, str], Path]:
     return take
 
 
+# Elements whose content is wider or taller than their box and is hidden
+# (cut-off text, a clipped button), and how far the page runs past the viewport.
+_CUT_OFF = """() => {
+  const cut = [];
+  for (const el of document.querySelectorAll('body *')) {
+    const style = getComputedStyle(el);
+    if (style.display === 'none' || style.visibility === 'hidden' || el.closest('svg')) continue;
+    const clipsX = ['hidden', 'clip'].includes(style.overflowX) || style.textOverflow === 'ellipsis';
+    const clipsY = ['hidden', 'clip'].includes(style.overflowY);
+    if ((clipsX && el.scrollWidth > el.clientWidth + 1) || (clipsY && el.scrollHeight > el.clientHeight + 1)) {
+      cut.push(el.tagName.toLowerCase() + (el.id ? '#' + el.id : '') + ': ' + (el.textContent || '').trim().slice(0, 60));
+    }
+  }
+  return {cut, overflow: document.documentElement.scrollWidth - window.innerWidth};
+}"""
+
+
+def assert_fits(page: Page) -> None:
+    """Fails when the page scrolls sideways or hides part of an element's content."""
+    found = page.evaluate(_CUT_OFF)
+    assert found["overflow"] <= 0, f"the page is {found['overflow']} px wider than the window"
+    assert not found["cut"], f"cut off: {found['cut']}"
+
+
 @pytest.fixture
 def sign_in(live_url: str) -> Callable[[Page, User], None]:
     """Signs the user in through the sign-in form, as a person would."""

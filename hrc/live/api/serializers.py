@@ -4,7 +4,7 @@ from typing import Any
 
 from rest_framework import serializers
 
-from hrc.cobots.validators import validate_cell
+from hrc.organisations.validators import validate_cell
 
 
 class CellRequestSerializer(serializers.Serializer[dict[str, Any]]):
