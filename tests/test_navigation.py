@@ -202,6 +202,16 @@ def test_the_start_page_counts_the_organisations_open_cases(
     assert "Running cases (1)" in response.content.decode()
 
 
+def test_the_start_page_counts_nothing_of_another_organisation(
+    outsider: User, choice_case: Case
+) -> None:
+    page = _client(outsider).get("/").content.decode()
+
+    assert "Other plant" in page
+    assert "Running cases (0)" in page
+    assert "Home plant" not in page
+
+
 def test_the_start_page_tells_a_person_in_no_organisation_whom_to_ask(loner: User) -> None:
     response = _client(loner).get("/")
 
