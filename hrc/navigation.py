@@ -81,6 +81,10 @@ def page_url(name: str, path: str) -> str | None:
     return path
 
 
+# Administration is several pages (people, teams, cells); its link opens the first.
+ADMINISTRATION = "/organisation/"
+
+
 def navigation_of(request: HttpRequest) -> Navigation:
     """The header's places for the person's role in their current organisation."""
     membership = current_membership(request)
@@ -103,7 +107,7 @@ def navigation_of(request: HttpRequest) -> Navigation:
         ]
         if role is Role.ADMIN:
             links.append(
-                ("Administration", page_url("organisation:people", "/organisation/people/"))
+                ("Administration", page_url("organisation:people", f"{ADMINISTRATION}people/"))
             )
     if request.user.is_superuser:
         links.append(("Site admin", reverse("admin:index")))
@@ -117,9 +121,13 @@ def navigation_of(request: HttpRequest) -> Navigation:
 
 
 def _current_url(path: str, urls: list[str]) -> str | None:
-    """The place the path lies in: the longest of the URLs that begins it."""
-    inside = [url for url in urls if path.startswith(url)]
+    """The place the path lies in: the longest of the URLs whose section begins it."""
+    inside = [url for url in urls if path.startswith(_section(url))]
     return max(inside, key=len, default=None)
+
+
+def _section(url: str) -> str:
+    return ADMINISTRATION if url.startswith(ADMINISTRATION) else url
 
 
 def navigation(request: HttpRequest) -> dict[str, Any]:

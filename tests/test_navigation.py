@@ -8,7 +8,7 @@ from django.test import Client
 from django.urls import Resolver404, resolve
 
 from hrc.cases.models import Case
-from hrc.navigation import SESSION_KEY
+from hrc.navigation import SESSION_KEY, _current_url
 from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
@@ -130,6 +130,23 @@ def test_the_header_marks_the_place_the_page_is_in(engineer: User, choice_case: 
         response = client.get(path)
         current = [label for label, _, now in _links(response.content.decode()).header if now]
         assert current == [place], path
+
+
+@pytest.mark.parametrize(
+    ("path", "current"),
+    [
+        ("/tablet/", "/tablet/"),
+        ("/tablet/press/", "/tablet/press/"),
+        ("/organisation/teams/", "/organisation/people/"),  # every administration page
+        ("/accounts/password_change/", None),
+    ],
+)
+def test_the_current_place_is_the_one_whose_section_holds_the_page(
+    path: str, current: str | None
+) -> None:
+    places = ["/tablet/", "/tablet/press/", "/organisation/people/"]
+
+    assert _current_url(path, places) == current
 
 
 def test_the_header_names_the_organisation(engineer: User) -> None:
