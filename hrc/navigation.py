@@ -1,14 +1,26 @@
-"""Where a signed-in person is: the organisation they are working in.
+"""Where a signed-in person is and where they may go: the header, the start page, the switcher.
 
 People in several organisations pick one (the header's switcher stores it in
 the session); everyone else is simply in their only one. Pages that act on
-"the organisation" (administration, starting a case) use this.
+"the organisation" (administration, starting a case) use current_membership.
+The header offers each role only the places that let it in: operators their
+tablets, engineers the patterns, cases, incidents, analytics and cobots,
+admins also the organisation's administration, superusers also /admin/.
 """
 
-from django.http import HttpRequest
+from dataclasses import dataclass, field
+from typing import Any
 
+from django.contrib.auth.decorators import login_required
+from django.http import HttpRequest, HttpResponse, HttpResponseRedirect
+from django.shortcuts import render
+from django.urls import NoReverseMatch, Resolver404, resolve, reverse
+from django.utils.functional import SimpleLazyObject
+from django.views.decorators.http import require_POST
+
+from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership
-from hrc.organisations.selectors import memberships_of
+from hrc.organisations.selectors import cells_of, memberships_of
 
 SESSION_KEY = "hrc.organisation"
 
@@ -22,3 +34,128 @@ def current_membership(request: HttpRequest) -> Membership | None:
         if membership is not None:
             return membership
     return memberships.first()
+
+
+# The header ---------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Place:
+    """A link of the header; `current` marks the page the person is on (aria-current)."""
+
+    label: str
+    url: str
+    current: bool = False
+
+
+@dataclass(frozen=True)
+class Navigation:
+    """What the header shows a signed-in person."""
+
+    membership: Membership | None
+    places: list[Place]
+    # The cells' tablets, for operators: a menu beside "Tablet".
+    cells: list[Place] = field(default_factory=list)
+    # Every membership, for the switcher; it is shown only when there are several.
+    memberships: list[Membership] = field(default_factory=list)
+
+    @property
+    def switchable(self) -> bool:
+        return len(self.memberships) > 1
+
+
+def page_url(name: str, path: str) -> str | None:
+    """The URL of the page named `name`, else `path` if something serves it, else None.
+
+    Pages other parts of the project build are linked before they exist and
+    shown once they do, so no link leads to a 404.
+    """
+    try:
+        return reverse(name)
+    except NoReverseMatch:
+        pass
+    try:
+        resolve(path)
+    except Resolver404:
+        return None
+    return path
+
+
+# Administration is several pages (people, teams, cells); its link opens the first.
+ADMINISTRATION = "/organisation/"
+
+
+def navigation_of(request: HttpRequest) -> Navigation:
+    """The header's places for the person's role in their current organisation."""
+    membership = current_membership(request)
+    role = Role(membership.role) if membership is not None else None
+    links: list[tuple[str, str | None]] = []
+    cells: list[tuple[str, str | None]] = []
+    if role is Role.OPERATOR and membership is not None:
+        links.append(("Tablet", reverse("tablet")))
+        cells = [
+            (cell.name, reverse("tablet-cell", args=[cell.name]))
+            for cell in cells_of(membership.organisation_id)
+        ]
+    elif role in (Role.ENGINEER, Role.ADMIN):
+        links += [
+            ("Patterns", reverse("patterns:list")),
+            ("Cases", reverse("cases:case-list")),
+            ("Incidents", reverse("cases:incident-list")),
+            ("Analytics", reverse("analytics:version-list")),
+            ("Cobots", reverse("cobots:cobot-list")),
+        ]
+        if role is Role.ADMIN:
+            links.append(
+                ("Administration", page_url("organisation:people", f"{ADMINISTRATION}people/"))
+            )
+    if request.user.is_superuser:
+        links.append(("Site admin", reverse("admin:index")))
+    current = _current_url(request.path, [url for _, url in links + cells if url])
+    return Navigation(
+        membership=membership,
+        places=[Place(label, url, url == current) for label, url in links if url],
+        cells=[Place(label, url, url == current) for label, url in cells if url],
+        memberships=list(memberships_of(request.user).order_by("organisation__name")),
+    )
+
+
+def _current_url(path: str, urls: list[str]) -> str | None:
+    """The place the path lies in: the longest of the URLs whose section begins it."""
+    inside = [url for url in urls if path.startswith(_section(url))]
+    return max(inside, key=len, default=None)
+
+
+def _section(url: str) -> str:
+    return ADMINISTRATION if url.startswith(ADMINISTRATION) else url
+
+
+def navigation(request: HttpRequest) -> dict[str, Any]:
+    """Context processor: `navigation` for the header, read only by pages that show it."""
+    if not request.user.is_authenticated:
+        return {}
+    return {"navigation": SimpleLazyObject(lambda: navigation_of(request))}
+
+
+# The switcher -------------------------------------------------------------------------------
+
+
+@login_required
+@require_POST
+def switch_organisation(request: HttpRequest) -> HttpResponse:
+    """Works in the organisation posted as `organisation` from now on, then starts there.
+
+    An id that is not a number is a 400; one of an organisation the person is
+    not a member of is a 404, as if it did not exist. Nothing is stored then.
+    """
+    raw = request.POST.get("organisation", "")
+    if not raw.isdigit():
+        return _refused(request, 400, "organisation: choose one of your organisations.")
+    if not memberships_of(request.user).filter(organisation_id=int(raw)).exists():
+        return _refused(request, 404, "organisation: you are not a member of that organisation.")
+    request.session[SESSION_KEY] = int(raw)
+    return HttpResponseRedirect(reverse("home"))
+
+
+def _refused(request: HttpRequest, status: int, message: str) -> HttpResponse:
+    return render(request, "refused.html", {"message": message}, status=status)

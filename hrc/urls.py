@@ -1,29 +1,41 @@
-"""URL map: a start page, admin, the REST API under /api/, its OpenAPI schema and browsable docs."""
+"""URL map: the start page, admin, the REST API under /api/, its OpenAPI schema and docs."""
 
 from django.contrib import admin
-from django.urls import include, path
-from django.views.generic import TemplateView
-from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerView
+from django.urls import include, path, re_path
+from drf_spectacular.views import SpectacularAPIView, SpectacularRedocView, SpectacularSwaggerView
 from rest_framework.authtoken.views import obtain_auth_token
 
+from hrc import home, navigation
+from hrc.api.views import api_not_found
+
 urlpatterns = [
-    path("", TemplateView.as_view(template_name="home.html"), name="home"),
+    # Sends each role to its place: operators to their tablet (also after sign-in).
+    path("", home.home, name="home"),
+    path("organisation/switch/", navigation.switch_organisation, name="switch-organisation"),
     path("admin/", admin.site.urls),
     # The operators' tablets (hrc.live).
     path("", include("hrc.live.urls")),
     path("", include("hrc.cases.urls")),  # the supervisor pages: /cases/, /incidents/
     path("", include("hrc.patterns.urls")),  # the pattern editor: /patterns/
+    # /analytics/: figures per version, Gantt per case
     path("", include("hrc.analytics.urls")),
-    path(
-        "", include("hrc.cobots.urls")
-    ),  # the cobot pages: /cobots/, control for engineers  # /analytics/: figures per version, Gantt per case
+    path("", include("hrc.cobots.urls")),  # the cobot pages: /cobots/, control for engineers
     # Sign-in, sign-out and password change for the tablets and the editor.
     path("accounts/", include("django.contrib.auth.urls")),
     path("api/schema/", SpectacularAPIView.as_view(), name="api-schema"),
+    # Swagger UI and ReDoc come from the project's static files (drf-spectacular-sidecar),
+    # so they work on a plant network with no way out.
     path("api/docs/", SpectacularSwaggerView.as_view(url_name="api-schema"), name="api-docs"),
+    path(
+        "api/redoc/",
+        SpectacularRedocView.as_view(url_name="api-schema", template_name="api/redoc.html"),
+        name="api-redoc",
+    ),
     # Machines trade a username and password for a token once, then send `Authorization: Token …`.
     path("api/token/", obtain_auth_token, name="api-token"),
-    path("api/", include("hrc.api.urls")),
     # Sign-in for the browsable API (session auth), so a person can try it from the browser.
     path("api/auth/", include("rest_framework.urls")),
+    path("api/", include("hrc.api.urls")),
+    # Last: any other address under /api/ answers a JSON 404, not an HTML page.
+    re_path(r"^api/", api_not_found),
 ]

@@ -32,6 +32,8 @@ INSTALLED_APPS = [
     "rest_framework",
     "rest_framework.authtoken",
     "drf_spectacular",
+    # Swagger UI and ReDoc as static files: /api/docs/ needs no CDN.
+    "drf_spectacular_sidecar",
     "channels",
     "hrc.organisations",
     "hrc.patterns",
@@ -66,6 +68,8 @@ TEMPLATES = [
                 "django.template.context_processors.request",
                 "django.contrib.auth.context_processors.auth",
                 "django.contrib.messages.context_processors.messages",
+                # The header: each role's places, the organisation and its switcher.
+                "hrc.navigation.navigation",
             ],
         },
     },
@@ -165,7 +169,8 @@ STATIC_ROOT = BASE_DIR / "staticfiles"
 # The editor and tablet bundles that `make install` builds from frontend/src.
 STATICFILES_DIRS = [BASE_DIR / "frontend" / "dist"]
 LOGIN_URL = "/accounts/login/"
-LOGIN_REDIRECT_URL = "/"
+# The start page sends each role on: operators to their tablet.
+LOGIN_REDIRECT_URL = "home"
 LOGOUT_REDIRECT_URL = "/accounts/login/"
 
 # A pattern document is small; anything near this is a mistake or an attack.
@@ -192,6 +197,12 @@ SPECTACULAR_SETTINGS = {
     "DESCRIPTION": "Human–robot collaboration patterns: model, check, publish and run.",
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
+    # From the project's static files, never a CDN: a plant's network may have no way out.
+    "SWAGGER_UI_DIST": "SIDECAR",
+    "SWAGGER_UI_FAVICON_HREF": "SIDECAR",
+    "REDOC_DIST": "SIDECAR",
+    # Swagger UI would send the schema to validator.swagger.io for its badge.
+    "SWAGGER_UI_SETTINGS": {"deepLinking": True, "validatorUrl": None},
 }
 
 # Cobot gateways and drivers. Certificates and trust lists (hrc.cobots.pki);

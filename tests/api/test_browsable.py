@@ -28,7 +28,7 @@ def test_the_browsable_api_renders(engineer: User, pattern: PatternModel, path: 
     assert response["Content-Type"].startswith("text/html")
 
 
-def test_the_start_page_links_to_the_admin_and_the_docs(db: None) -> None:
+def test_the_start_page_links_to_the_sign_in_and_the_docs(db: None) -> None:
     page = Client().get("/").content.decode()
-    assert 'href="/admin/"' in page
+    assert 'href="/accounts/login/"' in page
     assert 'href="/api/docs/"' in page

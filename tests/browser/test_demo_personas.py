@@ -16,7 +16,8 @@ import pytest
 from playwright.sync_api import Page, Response, expect
 
 from hrc.demo.library import EXAMPLES_DIR, example_files
-from hrc.demo.organisation import PERSONAS, Persona
+from hrc.demo.organisation import ORGANISATION_NAME, PERSONAS, Persona
+from hrc.organisations.choices import Role
 from tests.demo.rig import DemoRun
 
 Screenshot = Callable[[Page, str], Path]
@@ -49,9 +50,17 @@ def _editor_works(page: Page) -> None:
     )
 
 
+def _start_page_works(page: Page) -> None:
+    """Operators are sent on to their tablet; the others see what to do first in the demo plant."""
+    if page.url.endswith("/tablet/"):
+        _tablet_works(page)
+    else:
+        _heading(ORGANISATION_NAME)(page)
+
+
 # path → what shows that the page works. One line per page.
 CHECKS: dict[str, Callable[[Page], None]] = {
-    "/": _heading("hrc"),
+    "/": _start_page_works,
     "/tablet/": _tablet_works,
     "/patterns/": _editor_works,
     "/cases/": _heading("Cases"),
@@ -90,11 +99,16 @@ def test_the_persona_signs_in_with_the_printed_password_and_its_pages_work(
     page.get_by_label("User name").fill(persona.username)
     page.get_by_label("Password").fill(demo.passwords()[persona.username])
     page.get_by_role("button", name="Sign in").click()
-    page.wait_for_url(f"{demo.url}/")
+    # Signing in sends operators to their tablet and the others to the start page.
+    page.wait_for_url(f"{demo.url}/tablet/" if persona.role == Role.OPERATOR else f"{demo.url}/")
 
     for path in ("/", *persona.pages):
         page.goto(f"{demo.url}{path}")
         CHECKS[path](page)
         name = path.strip("/").replace("/", "-") or "home"
         screenshot(page, f"demo-{persona.username}-{name}")
+    # Every place the header offers the persona lets them in (a refusal is noted above).
+    header = page.locator("header.site nav.places a")
+    for href in [link.get_attribute("href") for link in header.all()]:
+        page.goto(f"{demo.url}{href}")
     assert not errors, errors

@@ -84,8 +84,7 @@ def test_an_operator_completes_a_started_use_case_on_make_demo_and_ctrl_c_ends_e
     page.get_by_label("User name").fill("operator1")
     page.get_by_label("Password").fill(demo.passwords()["operator1"])
     page.get_by_role("button", name="Sign in").click()
-    page.wait_for_url(f"{demo.url}/")
-    page.goto(f"{demo.url}/tablet/")
+    page.wait_for_url(f"{demo.url}/tablet/")  # an operator lands at the tablet
     expect(page.locator(".connection")).to_have_text("Live")
     cobot2 = page.locator(".cobots .cobot", has_text="cobot2")
     expect(cobot2.locator("dd.mode")).to_have_text("Running", timeout=LIVE_MS)

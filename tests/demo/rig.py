@@ -190,7 +190,8 @@ class Browserless:
             return error.code, error.url, error.read().decode(errors="replace")
 
     def sign_in(self, username: str, password: str) -> bool:
-        """Fills the sign-in form; True when the server took it (and sent us to the start page)."""
+        """Fills the sign-in form; True when the server took it and sent us on (operators to
+        their tablet, the others to the start page) instead of back to the form."""
         self.get("/accounts/login/")
         token = next(c.value for c in self.cookies if c.name == "csrftoken")
         form = urllib.parse.urlencode(
@@ -200,7 +201,7 @@ class Browserless:
             f"{self.url}/accounts/login/", data=form, headers={"Referer": f"{self.url}/"}
         )
         with self.opener.open(request, timeout=30) as response:
-            return bool(urlsplit(response.url).path == "/")
+            return bool(urlsplit(response.url).path != "/accounts/login/")
 
     def cookie_header(self) -> str:
         return "; ".join(f"{c.name}={c.value}" for c in self.cookies)
