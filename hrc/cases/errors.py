@@ -6,9 +6,13 @@ class CaseError(Exception):
 
 
 class Invalid(CaseError):
-    """The input is wrong (400); the message names what."""
+    """The input is wrong (400); the message names what, `field` where (a form shows it there)."""
 
     status = 400
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
 
 
 class NotAllowed(CaseError):

@@ -52,6 +52,11 @@ class Case(models.Model):
     started_by = models.ForeignKey(
         _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
     )
+    reference = models.CharField(
+        max_length=100,
+        blank=True,
+        help_text="What the case works on, as the plant names it: an order or workpiece number.",
+    )
     started_at = models.DateTimeField(auto_now_add=True)
     ended_at = models.DateTimeField(null=True, blank=True)
     last_seq = models.PositiveIntegerField(

@@ -40,10 +40,14 @@ from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkI
 from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, resolve
+from hrc.engine.startdata import check_start_data
 from hrc.engine.taskconfig import POSE_LENGTH, TaskConfig
 from hrc.live import broadcast as live
 from hrc.patterns.models import PatternVersion
 
+# A start form's "count": enough for a shift's batch, not a load test by accident.
+MAX_CASES_AT_ONCE = 50
+REFERENCE_LENGTH = Case._meta.get_field("reference").max_length or 100
 # advance() repeats settle → messages → held completions until nothing changes;
 # each round consumes a token or a message, so a sound net stops long before this.
 MAX_ROUNDS = 10_000
@@ -58,32 +62,70 @@ def start_case(
     started_by: User | None,
     actor_mapping: Mapping[str, Any] | None = None,
     data: Mapping[str, Any] | None = None,
+    reference: str = "",
 ) -> Case:
     """Starts a case of a published version; the mapping overrides the version's defaults per actor,
     `data` the pattern's initial data per key.
 
-    Raises Invalid when an actor is left unmapped or mapped to someone outside the organisation.
+    Raises Invalid when the version is retired, an actor is left unmapped or
+    mapped to someone outside the organisation, or a data key is not the
+    pattern's or not of its type.
     """
+    return start_cases(
+        version,
+        started_by=started_by,
+        actor_mapping=actor_mapping,
+        data=data,
+        reference=reference,
+        count=1,
+    )[0]
+
+
+def start_cases(
+    version: PatternVersion,
+    *,
+    started_by: User | None,
+    actor_mapping: Mapping[str, Any] | None = None,
+    data: Mapping[str, Any] | None = None,
+    reference: str = "",
+    count: int = 1,
+) -> list[Case]:
+    """Starts `count` cases alike, all or none (start_case's checks, once)."""
+    if version.retired_at is not None:
+        raise Invalid(f"{version} is retired: it starts no new cases.", "version")
+    if not 1 <= count <= MAX_CASES_AT_ONCE:
+        raise Invalid(f"Start between 1 and {MAX_CASES_AT_ONCE} cases at once.", "count")
+    if len(reference) > REFERENCE_LENGTH:
+        raise Invalid(f"The reference is longer than {REFERENCE_LENGTH} characters.", "reference")
     net = case_net(version)
     organisation = version.pattern.organisation
     mapping = {**(version.default_actor_mapping or {}), **(actor_mapping or {})}
     mapping = resolve_actor_mapping(net.pattern, organisation, mapping)
     if data is not None and not isinstance(data, Mapping):
-        raise Invalid("The case data must be a JSON object.")
+        raise Invalid("The case data must be a JSON object.", "data")
+    for key, problem in check_start_data(net.initial_data(), data or {}).items():
+        raise Invalid(problem, f"data.{key}")
+    cases = []
     with transaction.atomic():
-        case = Case.objects.create(
-            organisation=organisation,
-            version=version,
-            marking=dict(net.initial),
-            data={**net.initial_data(), **(data or {})},  # the pattern's `data`, then the case's
-            actor_mapping=mapping,
-            started_by=started_by,
-        )
-        case = lock_case(case.pk)
-        record_event(case, EventType.CASE_STARTED, user=started_by, after=net.initial)
-        advance(case, net)
-        case.save()
-    return case
+        for _ in range(count):
+            case = Case.objects.create(
+                organisation=organisation,
+                version=version,
+                marking=dict(net.initial),
+                data={
+                    **net.initial_data(),
+                    **(data or {}),
+                },  # the pattern's `data`, then the case's
+                actor_mapping=mapping,
+                started_by=started_by,
+                reference=reference,
+            )
+            case = lock_case(case.pk)
+            record_event(case, EventType.CASE_STARTED, user=started_by, after=net.initial)
+            advance(case, net)
+            case.save()
+            cases.append(case)
+    return cases
 
 
 def set_default_actor_mapping(

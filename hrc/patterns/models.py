@@ -10,6 +10,7 @@ from typing import Any
 from django.conf import settings
 from django.db import models
 
+from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.patterns.documents import validate_storable_document
 
@@ -42,6 +43,11 @@ class PatternModel(models.Model):
     )
     created_at = models.DateTimeField(auto_now_add=True, help_text="When the pattern was created.")
     updated_at = models.DateTimeField(auto_now=True, help_text="When the draft was last saved.")
+    archived_at = models.DateTimeField(
+        null=True,
+        blank=True,
+        help_text="Set while the pattern is archived: listed only on request; its versions stay.",
+    )
 
     class Meta:
         ordering = ["organisation__name", "name", "id"]
@@ -49,6 +55,10 @@ class PatternModel(models.Model):
 
     def __str__(self) -> str:
         return self.name
+
+
+def default_start_roles() -> list[str]:
+    return [Role.ADMIN.value, Role.ENGINEER.value]
 
 
 class ImmutableVersionError(Exception):
@@ -85,6 +95,23 @@ class PatternVersion(models.Model):
             "{team: ...} | {cobot: ...}}. The one setting of a version that may change "
             "(services.set_default_actor_mapping); the document and report never do."
         ),
+    )
+    # Who may start cases is the organisation's business, not the document's, so it
+    # changes on a published version as the mapping does.
+    start_roles = models.JSONField(
+        default=default_start_roles,
+        blank=True,
+        help_text="The roles that may start its cases: admin, engineer, operator.",
+    )
+    start_cells = models.JSONField(
+        default=list,
+        blank=True,
+        help_text="The cells whose tablets offer operators to start a case (with 'operator' in start_roles).",
+    )
+    retired_at = models.DateTimeField(
+        null=True,
+        blank=True,
+        help_text="Set while the version is retired: it starts no new case; running ones go on.",
     )
 
     class Meta:

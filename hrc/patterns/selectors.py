@@ -2,7 +2,8 @@
 
 from django.db.models import Max, QuerySet
 
-from hrc.organisations.selectors import AnyUser, organisations_of
+from hrc.organisations.choices import Role
+from hrc.organisations.selectors import AnyUser, organisations_of, role_in
 from hrc.patterns.models import PatternModel, PatternVersion
 
 
@@ -29,3 +30,37 @@ def versions_of(pattern: PatternModel) -> QuerySet[PatternVersion]:
 
 def latest_version(pattern: PatternModel) -> PatternVersion | None:
     return versions_of(pattern).first()
+
+
+def why_may_not_start(user: AnyUser, version: PatternVersion, *, cell: str = "") -> str | None:
+    """Why the user may not start a case of the version (at `cell`, for operators); None when they may.
+
+    The version's start rights name the roles that may start it; operators
+    start only at a tablet of one of its start cells, with its default mapping.
+    """
+    role = role_in(user, version.pattern.organisation_id)
+    if role is None:
+        return f"You are not a member of {version.pattern.organisation}."
+    if version.retired_at is not None:
+        return f"{version} is retired: it starts no new cases."
+    if role not in version.start_roles:
+        return f"{role.label}s may not start cases of {version}."
+    if role == Role.OPERATOR and cell not in version.start_cells:
+        where = ", ".join(version.start_cells) or "no cell"
+        return f"Operators start {version} at the tablet of its cells ({where}), not here."
+    return None
+
+
+def versions_startable_at(user: AnyUser, cell: str) -> list[PatternVersion]:
+    """The versions the user may start at the tablet of `cell`: in service, offered there, their role."""
+    # Filtered here, not in SQL: SQLite, the embedded default, has no JSON containment.
+    candidates = (
+        versions_visible_to(user)
+        .filter(retired_at__isnull=True)
+        .order_by("pattern__name", "-number")
+    )
+    return [
+        version
+        for version in candidates
+        if cell in version.start_cells and why_may_not_start(user, version, cell=cell) is None
+    ]

@@ -10,14 +10,18 @@ check the data. Errors:
 - PatternHasVersions: a published pattern cannot be deleted.
 """
 
+from collections.abc import Iterable
 from typing import Any
 
 from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 from django.db import transaction
 from django.db.models import Max
+from django.utils import timezone
 
+from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
+from hrc.organisations.selectors import cells_of
 from hrc.patterns.documents import (
     Report,
     check_report,
@@ -139,6 +143,49 @@ def publish_pattern(pattern: PatternModel, *, published_by: User) -> PatternVers
             report=report,
             published_by=published_by,
         )
+
+
+def archive_pattern(pattern: PatternModel, *, archived: bool) -> PatternModel:
+    """Archives the pattern (listed only on request) or brings it back; its versions stay."""
+    pattern.archived_at = timezone.now() if archived else None
+    PatternModel.objects.filter(pk=pattern.pk).update(archived_at=pattern.archived_at)
+    return pattern
+
+
+def retire_version(version: PatternVersion, *, retired: bool) -> PatternVersion:
+    """Retires the version (no new case starts; running ones go on) or puts it back in service."""
+    version.retired_at = timezone.now() if retired else None
+    PatternVersion.objects.filter(pk=version.pk).update(retired_at=version.retired_at)
+    return version
+
+
+def set_start_rights(
+    version: PatternVersion, *, roles: Iterable[str], cells: Iterable[str]
+) -> PatternVersion:
+    """Sets who may start the version's cases: roles, and the cells whose tablets offer it.
+
+    Raises ValidationError naming `start_roles` or `start_cells` for a role that
+    does not exist or a cell the organisation does not have.
+    """
+    roles, cells = sorted(set(roles)), sorted(set(cells))
+    unknown_roles = [role for role in roles if role not in Role.values]
+    if unknown_roles:
+        raise ValidationError(
+            {
+                "start_roles": f"No such role: {', '.join(unknown_roles)} (one of {', '.join(Role.values)})."
+            }
+        )
+    known = set(cells_of(version.pattern.organisation_id).values_list("name", flat=True))
+    unknown_cells = [cell for cell in cells if cell not in known]
+    if unknown_cells:
+        raise ValidationError(
+            {
+                "start_cells": f"{version.pattern.organisation} has no cell {', '.join(unknown_cells)}."
+            }
+        )
+    PatternVersion.objects.filter(pk=version.pk).update(start_roles=roles, start_cells=cells)
+    version.start_roles, version.start_cells = roles, cells
+    return version
 
 
 def _check_draft(document: object) -> None:

@@ -268,6 +268,7 @@ class CaseSummarySerializer(serializers.ModelSerializer[Case]):
             "version",
             "version_number",
             "status",
+            "reference",
             "started_by",
             "started_at",
             "ended_at",
@@ -326,7 +327,21 @@ class StartCaseRequestSerializer(serializers.Serializer[dict[str, Any]]):
         child=serializers.DictField(),
         required=False,
         help_text="Overrides the version's default mapping per actor: {actor: {users: [...]} | "
-        "{team: id or name} | {cobot: id or name}}.",
+        "{team: id or name} | {cobot: id or name}}. Not for operators: they start with the defaults.",
+    )
+    reference = serializers.CharField(
+        required=False,
+        allow_blank=True,
+        max_length=100,
+        default="",
+        help_text="What the case works on: an order or workpiece number.",
+    )
+    cell = serializers.CharField(
+        required=False,
+        allow_blank=True,
+        default="",
+        max_length=50,
+        help_text="The cell whose tablet starts it: operators start only at one of the version's start cells.",
     )
 
     def get_fields(self) -> dict[str, serializers.Field[Any, Any, Any, Any]]:

@@ -10,6 +10,7 @@ client as 400, 403 or 409 with a `detail` (hrc.api.exceptions).
 """
 
 import re
+from collections.abc import Sequence
 from typing import Any
 
 from django.contrib.auth.models import User
@@ -18,6 +19,7 @@ from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema
 from rest_framework import generics, mixins, serializers, status, viewsets
 from rest_framework.decorators import action
 from rest_framework.exceptions import PermissionDenied
+from rest_framework.permissions import IsAuthenticated
 from rest_framework.request import Request
 from rest_framework.response import Response
 from rest_framework.views import APIView
@@ -49,9 +51,10 @@ from hrc.cases.choices import CaseStatus, WorkItemKind
 from hrc.cases.errors import NotFound
 from hrc.cases.messages import receive_message
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
-from hrc.organisations.selectors import may_write_in
+from hrc.organisations.choices import Role
+from hrc.organisations.selectors import may_write_in, role_in
 from hrc.patterns.models import PatternVersion
-from hrc.patterns.selectors import versions_visible_to
+from hrc.patterns.selectors import versions_visible_to, why_may_not_start
 
 ID_PATTERN = re.compile(r"[0-9]{1,18}")  # fits a bigint primary key
 
@@ -111,18 +114,33 @@ class CaseViewSet(mixins.ListModelMixin, mixins.RetrieveModelMixin, viewsets.Gen
     @extend_schema(
         request=StartCaseRequestSerializer, responses={201: CaseSerializer, **WRITE_REFUSALS}
     )
+    def get_permissions(self) -> Sequence[Any]:
+        # Who may start a case is the version's start rights (operators too, at their cell),
+        # decided in create once the version is known.
+        if self.action == "create":
+            return [IsAuthenticated()]
+        return super().get_permissions()
+
     def create(self, request: Request) -> Response:
-        """Starts a case of a published version (engineers and admins of its organisation)."""
+        """Starts a case of a published version: as the version's start rights allow (by default
+        engineers and admins; operators at the tablet of one of its start cells)."""
         body = StartCaseRequestSerializer(data=request.data, context={"request": request})
         body.is_valid(raise_exception=True)
         version: PatternVersion = body.validated_data["version"]
-        if not may_write_in(request.user, version.pattern.organisation_id):
-            raise PermissionDenied(WRITERS_ONLY)
+        refusal = why_may_not_start(request.user, version, cell=body.validated_data["cell"])
+        if refusal is not None:
+            raise PermissionDenied(refusal)
+        mapping = body.validated_data.get("actor_mapping")
+        if mapping and role_in(request.user, version.pattern.organisation_id) == Role.OPERATOR:
+            raise PermissionDenied(
+                "Operators start cases with the version's mapping; leave actor_mapping out."
+            )
         case = services.start_case(
             version,
             started_by=_user(request),
-            actor_mapping=body.validated_data.get("actor_mapping"),
+            actor_mapping=mapping,
             data=body.validated_data.get("data"),
+            reference=body.validated_data["reference"],
         )
         return Response(self._detail(case), status=status.HTTP_201_CREATED)
 

@@ -4,6 +4,7 @@ from typing import Any
 
 from rest_framework import serializers
 
+from hrc.engine.startdata import defaults_of, start_schema
 from hrc.organisations.api.serializers import MemberOrganisationField
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel, PatternVersion
@@ -30,6 +31,7 @@ class PatternSummarySerializer(serializers.ModelSerializer[PatternModel]):
             "created_by",
             "created_at",
             "updated_at",
+            "archived_at",
         ]
         read_only_fields = fields
 
@@ -55,7 +57,14 @@ class PatternSerializer(PatternSummarySerializer):
 
     class Meta(PatternSummarySerializer.Meta):
         fields = [*PatternSummarySerializer.Meta.fields, "draft"]
-        read_only_fields = ["id", "latest_version", "created_by", "created_at", "updated_at"]
+        read_only_fields = [
+            "id",
+            "latest_version",
+            "created_by",
+            "created_at",
+            "updated_at",
+            "archived_at",
+        ]
 
     def validate_organisation(self, organisation: Organisation) -> Organisation:
         if self.instance is not None and organisation.pk != self.instance.organisation_id:
@@ -67,11 +76,53 @@ class PatternVersionSummarySerializer(serializers.ModelSerializer[PatternVersion
     published_by: serializers.SlugRelatedField[Any] = serializers.SlugRelatedField(
         slug_field="username", read_only=True
     )
+    pattern_name = serializers.CharField(source="pattern.name", read_only=True)
+    pattern_class = serializers.SerializerMethodField(
+        help_text="The collaboration pattern(s) the check found: synchronized, cooperation, …"
+    )
+    start_form = serializers.SerializerMethodField(
+        help_text="The start data as a JSON Schema: one field per key of the pattern's data."
+    )
 
     class Meta:
         model = PatternVersion
-        fields = ["id", "pattern", "number", "published_by", "published_at"]
+        fields = [
+            "id",
+            "pattern",
+            "pattern_name",
+            "pattern_class",
+            "number",
+            "published_by",
+            "published_at",
+            "retired_at",
+            "start_roles",
+            "start_cells",
+            "start_form",
+        ]
         read_only_fields = fields
+
+    def get_pattern_class(self, version: PatternVersion) -> list[str]:
+        return list(version.report.get("patterns", []))
+
+    def get_start_form(self, version: PatternVersion) -> dict[str, Any]:
+        return start_schema(defaults_of(version.document))
+
+
+class StartRightsSerializer(serializers.Serializer[dict[str, Any]]):
+    roles = serializers.ListField(
+        child=serializers.CharField(),
+        help_text="Roles that may start cases: admin, engineer, operator.",
+    )
+    cells = serializers.ListField(
+        child=serializers.CharField(),
+        required=False,
+        default=list,
+        help_text="Cells whose tablets offer operators to start a case.",
+    )
+
+
+class SwitchSerializer(serializers.Serializer[dict[str, Any]]):
+    on = serializers.BooleanField(help_text="true: retire (or archive); false: back in service.")
 
 
 class PatternVersionSerializer(PatternVersionSummarySerializer):

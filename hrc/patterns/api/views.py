@@ -26,6 +26,7 @@ from rest_framework import serializers, status, viewsets
 from rest_framework.decorators import action
 from rest_framework.request import Request
 from rest_framework.response import Response
+from rest_framework.views import APIView
 
 from hrc.api.exceptions import Rejected
 from hrc.api.negotiation import FormatParameterForViews
@@ -47,6 +48,8 @@ from hrc.patterns.api.serializers import (
     PatternVersionSerializer,
     PatternVersionSummarySerializer,
     PublishRefusedSerializer,
+    StartRightsSerializer,
+    SwitchSerializer,
 )
 from hrc.patterns.choices import DocumentFormat
 from hrc.patterns.documents import (
@@ -63,7 +66,12 @@ from hrc.patterns.documents import (
     to_pnml,
 )
 from hrc.patterns.models import PatternModel, PatternVersion
-from hrc.patterns.selectors import patterns_visible_to, versions_of, versions_visible_to
+from hrc.patterns.selectors import (
+    patterns_visible_to,
+    versions_of,
+    versions_startable_at,
+    versions_visible_to,
+)
 
 XML_MEDIA_TYPES = ("application/xml", "text/xml")
 ID_PATTERN = re.compile(r"[0-9]{1,18}")  # fits a bigint primary key
@@ -86,6 +94,13 @@ EXPORT_RESPONSES = {
 
 
 DRAFT_WRITE_RESPONSES = {200: PatternSerializer, 400: DocumentErrorSerializer}
+
+
+class WritersOfThePattern(MembersReadWritersWrite):
+    """MembersReadWritersWrite for a version, whose organisation is its pattern's."""
+
+    def has_object_permission(self, request: Request, view: APIView, obj: Any) -> bool:
+        return super().has_object_permission(request, view, obj.pattern)
 
 
 @extend_schema_view(
@@ -170,6 +185,16 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
                 }
             ) from None
         return Response(PatternVersionSerializer(version).data, status=status.HTTP_201_CREATED)
+
+    @extend_schema(request=SwitchSerializer, responses=PatternSerializer)
+    @action(detail=True, methods=["post"])
+    def archive(self, request: Request, pk: str | None = None) -> Response:
+        """`{"on": true}` archives the pattern (listed only on request), false brings it back."""
+        pattern = self.get_object()
+        body = SwitchSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        services.archive_pattern(pattern, archived=body.validated_data["on"])
+        return Response(PatternSerializer(pattern).data)
 
     @extend_schema(responses={200: PatternVersionSummarySerializer(many=True)})
     @action(detail=True, methods=["get"])
@@ -299,9 +324,11 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
 
 
 class PatternVersionViewSet(viewsets.ReadOnlyModelViewSet[PatternVersion]):
-    """Published versions of your organisations' patterns. Immutable: there is no write."""
+    """Published versions of your organisations' patterns. The document is immutable; engineers and
+    admins set who may start its cases and retire it."""
 
     content_negotiation_class = FormatParameterForViews
+    permission_classes = [WritersOfThePattern]
 
     def get_queryset(self) -> QuerySet[PatternVersion]:
         versions = versions_visible_to(self.request.user).order_by("pattern_id", "-number")
@@ -314,10 +341,43 @@ class PatternVersionViewSet(viewsets.ReadOnlyModelViewSet[PatternVersion]):
         return PatternVersionSerializer
 
     @extend_schema(
-        parameters=[OpenApiParameter("pattern", int, description="Only this pattern's versions.")]
+        parameters=[
+            OpenApiParameter("pattern", int, description="Only this pattern's versions."),
+            OpenApiParameter(
+                "startable_at",
+                str,
+                description="Only the versions you may start at this cell's tablet.",
+            ),
+        ]
     )
     def list(self, request: Request, *args: Any, **kwargs: Any) -> Response:
+        cell = request.query_params.get("startable_at")
+        if cell is not None:
+            startable = versions_startable_at(request.user, cell)
+            return Response(PatternVersionSummarySerializer(startable, many=True).data)
         return super().list(request, *args, **kwargs)
+
+    @extend_schema(request=StartRightsSerializer, responses=PatternVersionSerializer)
+    @action(detail=True, methods=["put"], url_path="start-rights")
+    def start_rights(self, request: Request, pk: str | None = None) -> Response:
+        """Sets the roles that may start the version's cases and the cells whose tablets offer it."""
+        version = self.get_object()
+        body = StartRightsSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        services.set_start_rights(
+            version, roles=body.validated_data["roles"], cells=body.validated_data["cells"]
+        )
+        return Response(PatternVersionSerializer(version).data)
+
+    @extend_schema(request=SwitchSerializer, responses=PatternVersionSerializer)
+    @action(detail=True, methods=["post"])
+    def retire(self, request: Request, pk: str | None = None) -> Response:
+        """`{"on": true}` retires the version (no new cases; running ones go on), false puts it back."""
+        version = self.get_object()
+        body = SwitchSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        services.retire_version(version, retired=body.validated_data["on"])
+        return Response(PatternVersionSerializer(version).data)
 
     @extend_schema(parameters=[FORMAT_PARAMETER], responses=EXPORT_RESPONSES)
     @action(detail=True, methods=["get"])
