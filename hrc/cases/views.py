@@ -13,19 +13,23 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
+from urllib.parse import urlencode
 
 from django.contrib.auth.decorators import login_required
+from django.contrib.auth.models import User
+from django.core.exceptions import ValidationError
 from django.core.paginator import Paginator
 from django.http import Http404, HttpRequest, HttpResponse
-from django.shortcuts import render
+from django.shortcuts import redirect, render
 from django.urls import reverse
 from django.utils import timezone
+from django.views.decorators.http import require_POST
 
-from hrc.cases import selectors
+from hrc.cases import selectors, services
 from hrc.cases.choices import (
     OPEN_CASE_STATUSES,
     OPEN_WORK_ITEM_STATES,
@@ -36,10 +40,15 @@ from hrc.cases.choices import (
     WorkItemState,
 )
 from hrc.cases.drawing import ConstraintLine, NetDrawing, Node, draw_net
+from hrc.cases.errors import Conflict, Invalid
+from hrc.cases.forms import MappingForm, StartForm, StartRightsForm
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
-from hrc.organisations.selectors import may_write_in, writable_organisations
+from hrc.organisations.choices import Role
+from hrc.organisations.selectors import cells_of, may_write_in, writable_organisations
 from hrc.patterns.models import PatternVersion
+from hrc.patterns.selectors import versions_visible_to, why_may_not_start
+from hrc.patterns.services import retire_version, set_start_rights
 
 CASES_PER_PAGE = 50
 INCIDENTS_PER_PAGE = 50
@@ -84,6 +93,9 @@ def case_list(request: HttpRequest) -> HttpResponse:
     except Refused as refused:
         return _refusal(request, refused)
     cases = selectors.supervised_cases(request.user)
+    version = request.GET.get("version", "")
+    if version.isascii() and version.isdigit() and len(version) <= 18:
+        cases = cases.filter(version_id=int(version))
     statuses = STATE_FILTERS[state]
     if statuses is not None:
         cases = cases.filter(status__in=sorted(statuses))
@@ -91,7 +103,7 @@ def case_list(request: HttpRequest) -> HttpResponse:
     return render(
         request,
         "cases/case_list.html",
-        {"page": page, "state": state, "states": list(STATE_FILTERS), "section": "cases"},
+        {"page": page, "state": state, "states": list(STATE_FILTERS), "version": version},
     )
 
 
@@ -177,7 +189,6 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "events": events,
         "before": before,
         "older": older,
-        "section": "cases",
         "script": {
             "page": "case",
             "organisations": [case.organisation_id],
@@ -369,5 +380,186 @@ def incident_list(request: HttpRequest) -> HttpResponse:
         },
         "live": page.number == 1,
     }
-    context = {"page": page, "script": script, "section": "incidents"}
+    context = {"page": page, "script": script}
     return render(request, "cases/incident_list.html", context)
+
+
+# Running a version: its page, starting cases, steering a case ------------------------------
+
+
+@login_required
+def version_detail(request: HttpRequest, pk: int) -> HttpResponse:
+    """A published version: its check report, default mapping, start rights, cases, retiring.
+
+    Engineers and admins change the mapping, the start rights and the retiring
+    here (POST `form` = mapping, rights, retire or reinstate); each refusal is
+    shown at its field and changes nothing.
+    """
+    try:
+        version = _supervised_version(request, pk)
+    except Refused as refused:
+        return _refusal(request, refused)
+    pattern = case_net(version).pattern
+    organisation = version.pattern.organisation
+    posted = request.POST if request.method == "POST" else None
+    which = request.POST.get("form", "")
+    mapping_form = MappingForm(
+        posted if which == "mapping" else None,
+        pattern=pattern,
+        organisation=organisation,
+        defaults=version.default_actor_mapping,
+        prefix="mapping",
+    )
+    rights_form = StartRightsForm(
+        posted if which == "rights" else None,
+        roles=list(Role.choices),
+        cells=list(cells_of(organisation.pk).values_list("name", flat=True)),
+        initial={"roles": version.start_roles, "cells": version.start_cells},
+        prefix="rights",
+    )
+    if posted is not None:
+        if which == "mapping" and mapping_form.is_valid():
+            try:
+                services.set_default_actor_mapping(version, mapping_form.mapping())
+                return _saved(request, version, "The default mapping is saved.")
+            except Invalid as invalid:
+                mapping_form.refuse(invalid)
+        elif which == "rights" and rights_form.is_valid():
+            try:
+                set_start_rights(
+                    version,
+                    roles=rights_form.cleaned_data["roles"],
+                    cells=rights_form.cleaned_data["cells"],
+                )
+                return _saved(request, version, "Who may start it is saved.")
+            except ValidationError as error:
+                for field, messages in error.message_dict.items():
+                    rights_form.add_error(
+                        field.removeprefix("start_") if field.startswith("start_") else None,
+                        messages,
+                    )
+        elif which in ("retire", "reinstate"):
+            retire_version(version, retired=which == "retire")
+            said = "retired: it starts no new cases" if which == "retire" else "back in service"
+            return _saved(request, version, f"Version {version.number} is {said}.")
+    cases = selectors.supervised_cases(request.user).filter(version=version)
+    context = {
+        "version": version,
+        "report": version.report,
+        "mapping_form": mapping_form,
+        "rights_form": rights_form,
+        "cases": cases[:CASES_PER_PAGE],
+        "case_count": cases.count(),
+        "saved": request.GET.get("saved", ""),
+    }
+    status = 400 if posted is not None else 200
+    return render(request, "cases/version_detail.html", context, status=status)
+
+
+@login_required
+def case_start(request: HttpRequest) -> HttpResponse:
+    """The start form: `?version=` chosen, the mapping (the version's defaults, overridable for
+    these cases), the start data, a reference and a count; all the cases start or none."""
+    try:
+        _require_supervisor(request)
+        version_id = request.GET.get("version", "")
+        if not version_id:
+            return _choose_version(request)
+        version = _supervised_version(request, _whole(version_id, "version"))
+    except Refused as refused:
+        return _refusal(request, refused)
+    net = case_net(version)
+    form = StartForm(
+        request.POST if request.method == "POST" else None,
+        pattern=net.pattern,
+        organisation=version.pattern.organisation,
+        defaults=version.default_actor_mapping,
+        data_defaults=net.initial_data(),
+    )
+    refusal = why_may_not_start(request.user, version)
+    if request.method == "POST" and refusal is None and form.is_valid():
+        try:
+            cases = services.start_cases(
+                version,
+                started_by=_user(request),
+                actor_mapping=form.mapping(),
+                data=form.start_data(),
+                reference=form.cleaned_data["reference"],
+                count=form.cleaned_data["count"],
+            )
+        except Invalid as invalid:
+            form.refuse(invalid)
+        else:
+            if len(cases) == 1:
+                return redirect("cases:case-detail", cases[0].pk)
+            return redirect(f"{reverse('cases:case-list')}?version={version.pk}")
+    context = {"version": version, "form": form, "refusal": refusal}
+    status = 400 if request.method == "POST" else 200
+    return render(request, "cases/case_start.html", context, status=status)
+
+
+@login_required
+@require_POST
+def case_control(request: HttpRequest, pk: int) -> HttpResponse:
+    """Cancels (`action=cancel`, with `confirm`), suspends or resumes the case, then shows it."""
+    try:
+        case = _supervised_case(request, pk)
+        action = request.POST.get("action", "")
+        steer = CASE_ACTIONS.get(action)
+        if steer is None:
+            raise Refused(400, f"action must be one of {', '.join(CASE_ACTIONS)}, not {action!r}.")
+        if action == "cancel" and request.POST.get("confirm") != "yes":
+            raise Refused(400, "Tick 'Yes, cancel this case' to cancel it.")
+        steer(case, by=_user(request))
+    except Refused as refused:
+        return _refusal(request, refused)
+    except Conflict as conflict:
+        return _refusal(request, Refused(409, str(conflict)))
+    return redirect("cases:case-detail", case.pk)
+
+
+CASE_ACTIONS: dict[str, Callable[..., Case]] = {
+    "cancel": services.cancel_case,
+    "suspend": services.suspend_case,
+    "resume": services.resume_case,
+}
+
+
+def _choose_version(request: HttpRequest) -> HttpResponse:
+    versions = [
+        version
+        for version in versions_visible_to(request.user)
+        .filter(
+            retired_at__isnull=True, pattern__organisation__in=writable_organisations(request.user)
+        )
+        .order_by("pattern__name", "-number")
+        if why_may_not_start(request.user, version) is None
+    ]
+    return render(request, "cases/case_start_choose.html", {"versions": versions})
+
+
+def _supervised_version(request: HttpRequest, pk: int) -> PatternVersion:
+    """The version if the user may see it (else 404) and run it (else 403)."""
+    version = versions_visible_to(request.user).filter(pk=pk).first()
+    if version is None:
+        raise Http404("No such version.")
+    if not may_write_in(request.user, version.pattern.organisation_id):
+        raise Refused(403, SUPERVISORS_ONLY)
+    return version
+
+
+def _saved(request: HttpRequest, version: PatternVersion, message: str) -> HttpResponse:
+    return redirect(
+        f"{reverse('cases:version', args=[version.pk])}?{urlencode({'saved': message})}"
+    )
+
+
+def _whole(value: str, name: str) -> int:
+    if not value.isascii() or not value.isdigit() or len(value) > 18:
+        raise Refused(400, f"{name} must be an id (a whole number), not {value!r}.")
+    return int(value)
+
+
+def _user(request: HttpRequest) -> User:
+    assert isinstance(request.user, User)  # login_required
+    return request.user

@@ -135,7 +135,7 @@ def test_a_mapping_to_someone_outside_the_organisation_is_a_400(
         format="json",
     )
     assert response.status_code == 400
-    assert "not a member of the organisation" in response.data["detail"]
+    assert "not an active member of the organisation" in response.data["detail"]
 
 
 # Reading ---------------------------------------------------------------------------------
