@@ -10,4 +10,5 @@ urlpatterns = [
     path("patterns/", views.pattern_list, name="list"),
     path("patterns/new/", views.pattern_new, name="new"),
     path("patterns/<int:pk>/edit/", views.pattern_edit, name="edit"),
+    path("patterns/<int:pk>/archive/", views.pattern_archive, name="archive"),
 ]

@@ -7,29 +7,75 @@ operator) gets 403 on the editor. The pages only read: the editor script
 the services' checks and refusal messages stay in one place.
 """
 
+from dataclasses import dataclass
 from typing import Any
 
 from django.contrib.auth.decorators import login_required
+from django.db.models import Prefetch
 from django.http import HttpRequest, HttpResponse
-from django.shortcuts import get_object_or_404, render
+from django.shortcuts import get_object_or_404, redirect, render
+from django.urls import reverse
 from django.views.decorators.csrf import ensure_csrf_cookie
+from django.views.decorators.http import require_POST
 
 from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import may_write_in, writable_organisations
+from hrc.patterns.models import PatternModel, PatternVersion
 from hrc.patterns.selectors import patterns_visible_to
+from hrc.patterns.services import archive_pattern
 
 WRITERS_ONLY = "Only engineers and admins of the organisation draw and change its patterns."
 
 
+@dataclass(frozen=True)
+class PatternRow:
+    pattern: PatternModel
+    can_edit: bool
+    versions: list[PatternVersion]
+
+    @property
+    def pattern_class(self) -> list[str]:
+        """The class the newest version was checked as (drafts are classified in the editor)."""
+        return list(self.versions[0].report.get("patterns", [])) if self.versions else []
+
+    @property
+    def startable(self) -> PatternVersion | None:
+        """The newest version in service: the one "Start a case" starts."""
+        return next((v for v in self.versions if v.retired_at is None), None)
+
+
 @login_required
 def pattern_list(request: HttpRequest) -> HttpResponse:
-    """Every pattern of the user's organisations; writers get "new" and "open"."""
+    """Every pattern of the user's organisations with its class and versions; writers get "new",
+    "open", "start a case" and archive. Archived patterns are listed with `?archived=1`."""
     writable = list(writable_organisations(request.user).order_by("name"))
     writable_ids = {organisation.pk for organisation in writable}
-    patterns = patterns_visible_to(request.user).order_by("organisation__name", "name", "id")
-    rows = [(pattern, pattern.organisation_id in writable_ids) for pattern in patterns]
-    return render(request, "patterns/list.html", {"rows": rows, "writable": writable})
+    archived = request.GET.get("archived") == "1"
+    patterns = (
+        patterns_visible_to(request.user)
+        .filter(archived_at__isnull=not archived)
+        .prefetch_related(Prefetch("versions", queryset=PatternVersion.objects.order_by("-number")))
+        .order_by("organisation__name", "name", "id")
+    )
+    rows = [
+        PatternRow(pattern, pattern.organisation_id in writable_ids, list(pattern.versions.all()))
+        for pattern in patterns
+    ]
+    context = {"rows": rows, "writable": writable, "archived": archived}
+    return render(request, "patterns/list.html", context)
+
+
+@login_required
+@require_POST
+def pattern_archive(request: HttpRequest, pk: int) -> HttpResponse:
+    """Archives a pattern (`archive=1`) or brings it back (`archive=0`), then lists the patterns."""
+    pattern = get_object_or_404(patterns_visible_to(request.user), pk=pk)
+    if not may_write_in(request.user, pattern.organisation_id):
+        return _refused(request, 403, WRITERS_ONLY)
+    archive = request.POST.get("archive") == "1"
+    archive_pattern(pattern, archived=archive)
+    return redirect(f"{reverse('patterns:list')}{'' if archive else '?archived=1'}")
 
 
 @login_required

@@ -11,6 +11,7 @@ from django.test import Client
 from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel
+from hrc.patterns.services import retire_version
 from tests import factories
 
 pytestmark = pytest.mark.django_db
@@ -119,3 +120,47 @@ def test_someone_in_no_organisation_sees_an_empty_list_and_may_not_create(loner:
 
 def test_the_start_page_links_to_the_patterns(engineer: User) -> None:
     assert 'href="/patterns/"' in _browser(engineer).get("/").content.decode()
+
+
+# The list: class, versions, archive --------------------------------------------------------
+
+
+def test_the_list_shows_each_patterns_class_and_versions_and_starts_the_newest_in_service(
+    engineer: User, organisation: Organisation
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer)
+    html = _browser(engineer).get("/patterns/").content.decode()
+    assert '<span class="class">Synchronized</span>' in html
+    assert f'href="/patterns/versions/{version.pk}/"' in html
+    assert f'href="/cases/new/?version={version.pk}"' in html
+    retire_version(version, retired=True)
+    html = _browser(engineer).get("/patterns/").content.decode()
+    assert f"/cases/new/?version={version.pk}" not in html
+
+
+def test_an_archived_pattern_is_listed_only_on_request_and_comes_back(
+    engineer: User, pattern: PatternModel
+) -> None:
+    client = _browser(engineer)
+    archived = client.post(f"/patterns/{pattern.pk}/archive/", {"archive": "1"})
+    assert archived.status_code == 302
+    assert "Hand-over" not in client.get("/patterns/").content.decode()
+    assert "Hand-over" in client.get("/patterns/?archived=1").content.decode()
+    client.post(f"/patterns/{pattern.pk}/archive/", {"archive": "0"})
+    pattern.refresh_from_db()
+    assert pattern.archived_at is None
+
+
+def test_only_writers_of_the_organisation_archive(
+    operator: User, outsider: User, pattern: PatternModel
+) -> None:
+    assert (
+        _browser(outsider).post(f"/patterns/{pattern.pk}/archive/", {"archive": "1"}).status_code
+        == 404
+    )
+    assert (
+        _browser(operator).post(f"/patterns/{pattern.pk}/archive/", {"archive": "1"}).status_code
+        == 403
+    )
+    pattern.refresh_from_db()
+    assert pattern.archived_at is None
