@@ -251,6 +251,9 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
         "Published version 1.", timeout=CHECKED
     )
     version = PatternVersion.objects.get()
+    # The next step is on the version's page.
+    page.get_by_role("link", name="Version 1: map actors and start cases").click()
+    page.wait_for_url(f"{live_url}/patterns/versions/{version.pk}/")
     assert version.number == 1
     assert version.pattern.name == "Assembly (1 operator, 1 cobot)"
     _assert_is_the_thesis_assembly(version.document)

@@ -100,6 +100,16 @@ export default class Toolbar {
       status.setAttribute("role", message.kind === "error" ? "alert" : "status");
     };
     eventBus.on("files.message", show);
+    // After publishing, the next step is on the version's page: who does what, and start cases.
+    const next = document.createElement("a");
+    next.className = "hrc-next";
+    next.hidden = true;
+    bar.appendChild(next);
+    eventBus.on("files.published", ({ version }: { version: { id: number; number: number } }) => {
+      next.href = `/patterns/versions/${version.id}/`;
+      next.textContent = `Version ${version.number}: map actors and start cases`;
+      next.hidden = false;
+    });
     eventBus.on(["files.changed", "commandStack.changed", "import.done"], () => {
       name.value = files.name;
       undo.disabled = !commandStack.canUndo();
