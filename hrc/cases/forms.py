@@ -84,25 +84,17 @@ class MappingForm(forms.Form):
         return chosen
 
     def refuse(self, invalid: Invalid) -> None:
-        """Shows the services' refusal at the field it names, else above the form."""
-        field = (invalid.field or "").replace("actor_mapping.", "actor__").replace(".", "__")
-        self.add_error(field if field in self.fields else None, str(invalid))
+        refuse(self, invalid)
 
 
-class StartForm(MappingForm):
-    """A case's start: the mapping (the version's defaults, overridable), its data, a reference
-    and how many cases alike to start."""
+class CycleForm(forms.Form):
+    """What one start of a version says: a reference and the start data (an operator's start at
+    their cell's tablet, with the version's mapping)."""
 
     reference = forms.CharField(
         required=False,
         max_length=100,
         help_text="What the case works on: an order or workpiece number.",
-    )
-    count = forms.IntegerField(
-        min_value=1,
-        max_value=MAX_CASES_AT_ONCE,
-        initial=1,
-        help_text=f"How many cases alike to start (at most {MAX_CASES_AT_ONCE}).",
     )
 
     def __init__(self, *args: Any, data_defaults: Mapping[str, Any], **kwargs: Any) -> None:
@@ -119,6 +111,46 @@ class StartForm(MappingForm):
             if value != field.default:
                 data[field.key] = value
         return data
+
+    def refuse(self, invalid: Invalid) -> None:
+        refuse(self, invalid)
+
+
+class StartForm(CycleForm):
+    """A case's start by an engineer or admin: the mapping (the version's defaults, overridable
+    for these cases), the start data, a reference and how many cases alike to start."""
+
+    count = forms.IntegerField(
+        min_value=1,
+        max_value=MAX_CASES_AT_ONCE,
+        initial=1,
+        help_text=f"How many cases alike to start (at most {MAX_CASES_AT_ONCE}).",
+    )
+
+    def __init__(
+        self,
+        *args: Any,
+        pattern: Pattern,
+        organisation: Organisation,
+        defaults: Mapping[str, Any],
+        data_defaults: Mapping[str, Any],
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(*args, data_defaults=data_defaults, **kwargs)
+        self.performers = MappingForm(
+            *args, pattern=pattern, organisation=organisation, defaults=defaults, **kwargs
+        )
+        self.fields.update(self.performers.fields)
+
+    def mapping(self) -> dict[str, dict[str, Any]]:
+        self.performers.cleaned_data = self.cleaned_data
+        return self.performers.mapping()
+
+
+def refuse(form: forms.Form, invalid: Invalid) -> None:
+    """Shows the services' refusal at the field it names (data.batch → data__batch), else above."""
+    field = (invalid.field or "").replace("actor_mapping.", "actor__").replace(".", "__")
+    form.add_error(field if field in form.fields else None, str(invalid))
 
 
 def data_form_field(field: StartField) -> forms.Field:
