@@ -316,8 +316,18 @@ def _check_form(config: TaskConfig, data: Mapping[str, Any]) -> None:
     if problems:
         raise Invalid(
             "The form is not filled in correctly: "
-            + "; ".join(f"{_field(p.absolute_path)}: {p.message}" for p in problems)
+            + "; ".join(_problem(config.form, p) for p in problems)
         )
+
+
+def _problem(form: Mapping[str, Any], problem: jsonschema.ValidationError) -> str:
+    # A required answer left out is named by the title the operator saw, not as a schema path.
+    if problem.validator == "required" and isinstance(problem.instance, Mapping):
+        properties = form.get("properties", {})
+        missing = [name for name in problem.validator_value if name not in problem.instance]
+        titles = [str(properties.get(name, {}).get("title", name)) for name in missing]
+        return ", ".join(f"{title}: not answered" for title in titles)
+    return f"{_field(problem.absolute_path)}: {problem.message}"
 
 
 def _field(path: Iterable[Any]) -> str:

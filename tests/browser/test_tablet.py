@@ -190,10 +190,18 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     card.get_by_role("button", name="Complete…").click()
     dialog = page.locator(".form-dialog")
     expect(dialog.get_by_label("Parts in the tray *")).to_be_visible()
+    # A yes/no is two answers, neither taken: nobody answered it yet.
+    clean = dialog.get_by_role("group", name="Tray is clean *")
+    for answer in ("Yes", "No"):
+        expect(clean.get_by_role("radio", name=answer)).not_to_be_checked()
     dialog.get_by_role("button", name="Complete").click()  # the form is empty: refused
-    expect(dialog.get_by_role("alert")).to_contain_text("parts")
+    expect(dialog.locator(".field-error:visible")).to_have_text(
+        ["Answer this before completing."] * 2
+    )
+    screenshot(page, "tablet-form-unanswered")
+    assert WorkItem.objects.get(case=case, task="to1").result is None  # nothing was sent
     dialog.get_by_label("Parts in the tray *").fill("12")
-    dialog.get_by_label("Tray is clean *").check()
+    clean.get_by_role("radio", name="Yes").check()
     screenshot(page, "tablet-form")
     dialog.get_by_role("button", name="Complete").click()
     expect(card).to_have_count(0, timeout=LIVE_MS)

@@ -50,7 +50,7 @@ def test_an_unknown_cell_says_so_and_lists_the_cells_without_a_stop(
     html = response.content.decode()
     assert "There is no cell “cell1” in" in html
     assert 'href="/tablet/cell-a/"' in html
-    assert "class=\"stop\"" not in html
+    assert 'class="stop"' not in html
 
 
 def test_a_cell_of_another_organisation_is_unknown_here(

@@ -15,6 +15,7 @@ import {
   degrees,
   elsewhere,
   humanSafety,
+  mayGiveBack,
   myTasks,
   nextAction,
   teamTasks,
@@ -120,6 +121,12 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     button.dataset.action = action;
     button.dataset.item = String(item.id);
     article.append(button);
+  }
+  if (mayGiveBack(state, item)) {
+    const back = element("button", "action give-back", "Give back");
+    back.dataset.action = "unclaim";
+    back.dataset.item = String(item.id);
+    article.append(back);
   }
   return article;
 }
@@ -260,7 +267,7 @@ async function openForm(id: number): Promise<void> {
   form.method = "dialog";
   form.noValidate = true; // the server checks the form and names each field it refuses
   const fields = element("div", "fields");
-  const read = renderForm(fields, detail.form);
+  const rendered = renderForm(fields, detail.form);
   const error = element("p", "errors");
   error.setAttribute("role", "alert");
   const cancel = element("button", "", "Cancel");
@@ -273,9 +280,13 @@ async function openForm(id: number): Promise<void> {
   form.append(element("h2", "", detail.label), element("p", "instructions", detail.instructions), fields, error, actions);
   form.addEventListener("submit", async (event) => {
     event.preventDefault();
+    if (!rendered.check()) {
+      error.textContent = "Some answers are missing: see the fields marked.";
+      return;
+    }
     submit.disabled = true;
     try {
-      await request("POST", `/api/work-items/${id}/complete/`, { data: read() });
+      await request("POST", `/api/work-items/${id}/complete/`, { data: rendered.read() });
       dialog.close();
     } catch (failure) {
       error.textContent = failure instanceof ApiError ? failure.message : String(failure);

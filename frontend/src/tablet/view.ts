@@ -117,6 +117,11 @@ export function nextAction(state: LiveState, item: WorkItemData): "claim" | "sta
   return null;
 }
 
+/** A task the operator claimed and has not started can be given back to the others who may do it. */
+export function mayGiveBack(state: LiveState, item: WorkItemData): boolean {
+  return item.state === "claimed" && item.claimed_by === state.user.id;
+}
+
 /** Joint angles in degrees, for the panel. */
 export function degrees(joints: number[]): number[] {
   return joints.map((value) => Math.round((value * 180) / Math.PI));

@@ -1,7 +1,7 @@
 import { describe, expect, it } from "vitest";
 import type { Snapshot } from "../../src/live/events";
 import { type LiveState, LiveStore } from "../../src/live/store";
-import { atThisCell, cellsOf, cellWords, elsewhere, myTasks, teamTasks } from "../../src/tablet/view";
+import { atThisCell, cellsOf, cellWords, elsewhere, mayGiveBack, myTasks, teamTasks } from "../../src/tablet/view";
 import { item, snapshot } from "../live/fixtures";
 
 const WELD_ARM = {
@@ -103,5 +103,15 @@ describe("cell words", () => {
     expect(cellWords(["assembly", "paint", "weld"], true)).toBe("the assembly, paint and weld cells");
     expect(cellWords([])).toBe("another cell");
     expect(cellWords([], true)).toBe("other cells");
+  });
+});
+
+describe("giving a task back", () => {
+  it("is offered on a task the operator claimed and has not started, and on no other", () => {
+    const state = floor("");
+    const mine = { ...item(101, 10), state: "claimed", claimed_by: state.user.id };
+    expect(mayGiveBack(state, mine)).toBe(true);
+    expect(mayGiveBack(state, { ...mine, state: "running" })).toBe(false);
+    expect(mayGiveBack(state, { ...mine, claimed_by: state.user.id + 1 })).toBe(false);
   });
 });

@@ -178,7 +178,7 @@ def test_unclaim_gives_the_task_back(
 @pytest.mark.parametrize(
     ("data", "named"),
     [
-        ({}, "the form: 'count' is a required property"),
+        ({}, "count: not answered"),
         ({"count": 0}, "count: 0 is less than the minimum of 1"),
         ({"count": "many"}, "count: 'many' is not of type 'integer'"),
     ],
