@@ -14,12 +14,10 @@ Screenshots: var/screenshots/demo-plant-*.png.
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import subprocess
 import time
-import urllib.request
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack
 from pathlib import Path
@@ -104,11 +102,13 @@ def test_an_operator_completes_a_started_use_case_on_make_demo_and_ctrl_c_ends_e
             screenshot(page, f"demo-plant-{name}-cobot-holds")
         _complete(page, card, {})
 
-    engineer = _token(demo, "engineer")
-    case = _until(lambda: _case(demo, engineer, fixture), lambda c: c["status"] != "running")
+    engineer = demo.token("engineer")
+    case = _until(
+        lambda: demo.get(engineer, f"/api/cases/{fixture}/"), lambda c: c["status"] != "running"
+    )
     assert case["status"] == "completed", case
     assert case["data"]["mounted"] == list(POSITIONS)
-    events = _get(demo, engineer, f"/api/cases/{fixture}/events/?limit=1000")["results"]
+    events = demo.get(engineer, f"/api/cases/{fixture}/events/?limit=1000")["results"]
     completed = [
         (e["actor"], e["task"], e["user"]) for e in events if e["type"] == "task-completed"
     ]
@@ -171,28 +171,6 @@ def _complete(page: Page, card: Any, form: dict[str, str]) -> None:
         dialog.get_by_label(field).select_option(label=value)
     dialog.get_by_role("button", name="Complete").click()
     expect(card).to_have_count(0, timeout=LIVE_MS)
-
-
-def _token(demo: DemoRun, username: str) -> str:
-    body = json.dumps({"username": username, "password": demo.passwords()[username]}).encode()
-    request = urllib.request.Request(
-        f"{demo.url}/api/token/", data=body, headers={"Content-Type": "application/json"}
-    )
-    with urllib.request.urlopen(request, timeout=30) as response:
-        return str(json.load(response)["token"])
-
-
-def _case(demo: DemoRun, token: str, case: int) -> dict[str, Any]:
-    return _get(demo, token, f"/api/cases/{case}/")
-
-
-def _get(demo: DemoRun, token: str, path: str) -> dict[str, Any]:
-    request = urllib.request.Request(
-        f"{demo.url}{path}", headers={"Authorization": f"Token {token}"}
-    )
-    with urllib.request.urlopen(request, timeout=30) as response:
-        answer: dict[str, Any] = json.load(response)
-        return answer
 
 
 def _until(

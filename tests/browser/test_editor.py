@@ -10,38 +10,41 @@ and say what is wrong; outsiders and operators are kept out.
 
 import json
 import re
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
 from django.contrib.auth.models import User
-from playwright.sync_api import FilePayload, FloatRect, Page, expect
+from playwright.sync_api import FilePayload, Page, expect
 
 from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
+from tests.browser.drawing import (
+    CHECKED,
+    append_node,
+    centre_of,
+    click_element,
+    connect,
+    drop_tool,
+    element_box,
+    near,
+    open_editor,
+    pad_action,
+    pattern_badge,
+    select_element,
+)
+from tests.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
 SignIn = Callable[[Page, User], None]
 Screenshot = Callable[[Page, str], Path]
 EXAMPLES = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples"
-# The server checks a moment after the model stops changing (LiveChecker, 600 ms).
-CHECKED = 15_000
 RUNNING = re.compile(r"\bhrc-running\b")
 STUCK = re.compile(r"\bhrc-stuck\b")
-
-
-def _open(page: Page, url: str) -> None:
-    page.goto(url)
-    expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
-
-
-def _badge(page: Page) -> Any:
-    return page.get_by_label("Pattern class")
 
 
 @pytest.mark.parametrize("example", sorted(path.stem for path in EXAMPLES.glob("*.json")))
@@ -57,11 +60,11 @@ def test_each_thesis_example_opens_in_its_lanes(
     document = json.loads((EXAMPLES / f"{example}.json").read_text())
     pattern = factories.make_pattern(organisation, draft=document, name=document["name"])
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
 
     declared = document["declared_pattern"].capitalize()
-    expect(_badge(page)).to_have_text(declared, timeout=CHECKED)
-    expect(_badge(page)).to_have_attribute("data-valid", "true")
+    expect(pattern_badge(page)).to_have_text(declared, timeout=CHECKED)
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true")
     # Every actor is a lane; every task sits inside its actor's lane.
     for actor in document["actors"]:
         lane = page.locator(f'[data-element-id="{actor["id"]}"]')
@@ -82,88 +85,6 @@ def test_each_thesis_example_opens_in_its_lanes(
     screenshot(page, f"editor-{example}")
 
 
-# Drawing with the mouse: positions come from what is on screen, as a person aims.
-
-
-def _box(page: Page, element_id: str) -> FloatRect:
-    """The element's box on screen: its hit area, which is the shape's bounds."""
-    box = page.locator(f'[data-element-id="{element_id}"] .djs-hit').first.bounding_box()
-    assert box is not None, f"{element_id} is not on the canvas"
-    return box
-
-
-def _centre(page: Page, element_id: str) -> tuple[float, float]:
-    box = _box(page, element_id)
-    return box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-
-
-def _near(box: FloatRect, other: FloatRect) -> bool:
-    return abs(box["x"] - other["x"]) < 2 and abs(box["y"] - other["y"]) < 2
-
-
-def _until(condition: Callable[[], bool], timeout: float = 15.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "condition not reached in time"
-        time.sleep(0.05)
-
-
-def _click(page: Page, element_id: str) -> None:
-    page.mouse.click(*_centre(page, element_id))
-
-
-def _select(page: Page, element_id: str) -> None:
-    """Clicks the element until it is selected. diagram-js swallows the first click for 0.4 s
-    after a drag ends (the drag's ghost click; a loaded machine runs that timer late), so a
-    click right after drawing an arc can select nothing; a second one comes a second later,
-    never a double click."""
-    selected = page.locator(f'.djs-element.selected[data-element-id="{element_id}"]')
-    for _ in range(3):
-        _click(page, element_id)
-        try:
-            expect(selected).to_have_count(1, timeout=1000)
-            return
-        except AssertionError:
-            continue
-    expect(selected).to_have_count(1)
-
-
-def _drop(page: Page, tool: str, x: float, y: float) -> None:
-    """Takes a node from the palette and drops it at (x, y)."""
-    page.get_by_role("button", name=tool, exact=True).click()
-    page.mouse.move(x, y, steps=6)
-    page.mouse.down()
-    page.mouse.up()
-
-
-def _pad(page: Page, action: str) -> None:
-    page.locator(f'.djs-context-pad.open [data-action="{action}"]').click()
-
-
-def _connect(page: Page, source: str, target: str, action: str = "connect") -> None:
-    """From the source's context pad, draws an arc (or a constraint) to the target."""
-    _select(page, source)
-    _pad(page, action)
-    x, y = _centre(page, target)
-    page.mouse.move(x, y, steps=8)
-    page.mouse.down()
-    page.mouse.up()
-
-
-def _append(page: Page, label: str = "") -> None:
-    """Appends the next node to the selected one with the A key; a task gets its label typed."""
-    selected = page.get_by_role("region", name="Properties").get_by_label("Id")
-    before = selected.input_value()
-    page.keyboard.press("a")
-    expect(selected).not_to_have_value(before)
-    if label:
-        field = page.locator(".hrc-label-input")
-        expect(field).to_be_focused()
-        page.keyboard.type(label)
-        page.keyboard.press("Enter")
-        expect(field).to_have_count(0)
-
-
 def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publishes(
     page: Page,
     live_url: str,
@@ -173,14 +94,14 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     screenshot: Screenshot,
 ) -> None:
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/new/")
+    open_editor(page, f"{live_url}/patterns/new/")
     name = page.get_by_label("Pattern name")
     name.fill("Assembly (1 operator, 1 cobot)")
     name.press("Enter")
 
     page.get_by_role("button", name="Cobot lane").click()
     page.get_by_role("button", name="Operator lane").click()
-    cobot, operator = _box(page, "c"), _box(page, "o")
+    cobot, operator = element_box(page, "c"), element_box(page, "o")
     # A cobot task must name its program (a task-config error otherwise): the lane's default.
     page.mouse.click(cobot["x"] + 10, cobot["y"] + cobot["height"] / 2)  # the lane's name strip
     expect(page.locator('.djs-element.selected[data-element-id="c"]')).to_have_count(1)
@@ -189,38 +110,38 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     program.press("Tab")
 
     # The cobot's line: p1 (with the case's token), a split, pick, place and fix the insert.
-    _drop(page, "Place", cobot["x"] + 100, cobot["y"] + cobot["height"] / 2)
-    _pad(page, "token.add")
-    _pad(page, "append.silent")
-    _append(page)
+    drop_tool(page, "Place", cobot["x"] + 100, cobot["y"] + cobot["height"] / 2)
+    pad_action(page, "token.add")
+    pad_action(page, "append.silent")
+    append_node(page)
     for label in ("pick insert", "place insert", "fix insert"):
-        _append(page, label)
-        _append(page)
+        append_node(page, label)
+        append_node(page)
     # The operator's line, in the operator's lane under p2.
-    p2_x, _ = _centre(page, "p2")
-    _drop(page, "Place", p2_x, operator["y"] + operator["height"] / 2)
+    p2_x, _ = centre_of(page, "p2")
+    drop_tool(page, "Place", p2_x, operator["y"] + operator["height"] / 2)
     for label in ("prepare workpiece", "check assembled insert"):
-        _append(page, label)
-        _append(page)
+        append_node(page, label)
+        append_node(page)
     # The join and the end.
-    _select(page, "p5")
-    _pad(page, "append.silent")
-    _append(page)
+    select_element(page, "p5")
+    pad_action(page, "append.silent")
+    append_node(page)
     page.get_by_role("button", name="Show all").click()
-    _connect(page, "t1", "p6")
-    _connect(page, "p8", "t2")
+    connect(page, "t1", "p6")
+    connect(page, "p8", "t2")
     screenshot(page, "editor-drawing-assembly-net")
     # The synchronisation: the cobot places only a prepared workpiece; the operator checks a fixed insert.
-    _connect(page, "to1", "tc2", "constraint.time")
-    _connect(page, "tc3", "to2", "constraint.time")
+    connect(page, "to1", "tc2", "constraint.time")
+    connect(page, "tc3", "to2", "constraint.time")
 
-    expect(_badge(page)).to_have_text("Synchronized", timeout=CHECKED)
-    expect(_badge(page)).to_have_attribute("data-valid", "true")
+    expect(pattern_badge(page)).to_have_text("Synchronized", timeout=CHECKED)
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true")
     screenshot(page, "editor-drawn-assembly")
 
     # A time constraint against the flow: the cobot's placing before the operator's preparing.
-    _connect(page, "tc2", "to1", "constraint.time")
-    expect(_badge(page)).to_have_attribute("data-sound", "false", timeout=CHECKED)
+    connect(page, "tc2", "to1", "constraint.time")
+    expect(pattern_badge(page)).to_have_attribute("data-sound", "false", timeout=CHECKED)
     for task in ("tc2", "to1"):
         expect(page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')).to_be_visible()
     deadlock = page.locator(".hrc-issue", has_text="can deadlock")
@@ -241,10 +162,10 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     bar.get_by_role("button", name="Stop").click()
 
     # Undo takes the contradiction back; the check agrees again.
-    _select(page, "p1")
+    select_element(page, "p1")
     page.keyboard.press("Control+z")
-    expect(_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
-    expect(_badge(page)).to_have_text("Synchronized")
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    expect(pattern_badge(page)).to_have_text("Synchronized")
 
     page.get_by_role("button", name="Publish", exact=True).click()
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text(
@@ -343,8 +264,8 @@ def test_a_malformed_file_changes_nothing_and_says_where(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
-    expect(_badge(page)).to_have_text("Synchronized", timeout=CHECKED)
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    expect(pattern_badge(page)).to_have_text("Synchronized", timeout=CHECKED)
     nodes = page.locator(".djs-shape")
     count = nodes.count()
     status = page.locator(".hrc-toolbar .hrc-status")
@@ -382,7 +303,7 @@ def test_a_bpmn_feature_hrc_does_not_map_is_refused_by_element_and_changes_nothi
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     status = page.locator(".hrc-toolbar .hrc-status")
     unmapped = BPMN.replace('<parallelGateway id="join"/>', '<inclusiveGateway id="join"/>')
     _import(page, "cell4.bpmn", unmapped)
@@ -403,7 +324,7 @@ def test_a_bpmn_file_imports_as_a_new_pattern_in_its_lanes(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     _import(page, "cell4.bpmn", BPMN)
     page.wait_for_url(_another_pattern(pattern), timeout=CHECKED)
     expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
@@ -423,14 +344,14 @@ def test_a_pattern_file_imports_as_a_new_pattern_and_exports_as_bpmn_and_pnml(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     polishing = (EXAMPLES / "coop_1o1c_polishing.json").read_text()
     _import(page, "polishing.json", polishing)
     page.wait_for_url(_another_pattern(pattern), timeout=CHECKED)
     imported = PatternModel.objects.exclude(pk=pattern.pk).get()
     assert page.url.endswith(f"/patterns/{imported.pk}/edit/")
     expect(page.locator("#hrc-editor")).to_have_attribute("data-ready", "true")
-    expect(_badge(page)).to_have_text("Cooperation", timeout=CHECKED)
+    expect(pattern_badge(page)).to_have_text("Cooperation", timeout=CHECKED)
     screenshot(page, "editor-imported-json")
 
     for format, marker in (
@@ -454,7 +375,7 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     page.get_by_role("button", name="Token game").click()
     bar = page.get_by_role("toolbar", name="Token game")
     caption = bar.locator(".hrc-game-caption")
@@ -464,22 +385,22 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
         return page.locator(f'.djs-element[data-element-id="{place}"] .hrc-token')
 
     expect(tokens("p1")).to_have_count(1)
-    _click(page, "tc1")  # not enabled yet: nothing happens
+    click_element(page, "tc1")  # not enabled yet: nothing happens
     expect(caption).to_have_text("Enabled: t1.")
-    _click(page, "t1")
+    click_element(page, "t1")
     expect(tokens("p1")).to_have_count(0)
     expect(tokens("p2")).to_have_count(1)
-    _click(page, "tc1")
+    click_element(page, "tc1")
     expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
     expect(caption).to_contain_text("Fired start tc1.")
-    _click(page, "tc1")
+    click_element(page, "tc1")
     expect(caption).to_contain_text("Fired complete tc1.")
     expect(tokens("p3")).to_have_count(1)
 
     # The constraint places, on demand: tc2 waits for to1's completion.
     bar.get_by_label("Constraint places").check()
     expect(page.locator(".hrc-constraint-place", has_text="to1 done, for tc2: 0")).to_be_visible()
-    _click(page, "tc2")
+    click_element(page, "tc2")
     expect(page.locator('.djs-element[data-element-id="tc2"]')).not_to_have_class(RUNNING)
     screenshot(page, "editor-token-game")
 
@@ -501,17 +422,17 @@ def test_a_refused_edit_says_why_and_draws_nothing(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     arcs = page.locator(".djs-connection .hrc-arc")
     constraints = page.locator(".djs-connection .hrc-constraint")
     count = arcs.count()
     hint = page.locator(".hrc-refusal")
 
-    _connect(page, "p2", "p3")
+    connect(page, "p2", "p3")
     expect(hint).to_have_text(
         "An arc cannot join two places (p2 → p3): put a transition between them."
     )
-    _connect(page, "tc1", "tc3", "constraint.func")
+    connect(page, "tc1", "tc3", "constraint.func")
     expect(hint).to_have_text(
         "tc1 and tc3 are both tasks of c: a constraint joins tasks of different actors."
     )
@@ -558,26 +479,26 @@ def test_a_dragged_node_is_laid_out_again_and_undo_brings_it_back(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
-    laid_out = _box(page, "p3")
-    x, y = _centre(page, "p3")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    laid_out = element_box(page, "p3")
+    x, y = centre_of(page, "p3")
     page.mouse.move(x, y)
     page.mouse.down()
     page.mouse.move(x + 30, y + 25, steps=8)
     page.mouse.up()
-    dragged = _box(page, "p3")
+    dragged = element_box(page, "p3")
     assert dragged["x"] > laid_out["x"] + 20
     assert dragged["y"] > laid_out["y"] + 15
 
     page.get_by_role("button", name="Layout").click()
-    _until(lambda: _near(_box(page, "p3"), laid_out))
+    until(lambda: near(element_box(page, "p3"), laid_out))
     # One undo takes the whole layout back; a second one the drag.
     page.keyboard.press("Control+z")
-    assert _near(_box(page, "p3"), dragged)
+    assert near(element_box(page, "p3"), dragged)
     page.keyboard.press("Control+z")
-    assert _near(_box(page, "p3"), laid_out)
+    assert near(element_box(page, "p3"), laid_out)
     page.keyboard.press("Control+y")
-    assert _near(_box(page, "p3"), dragged)
+    assert near(element_box(page, "p3"), dragged)
 
 
 def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
@@ -590,7 +511,7 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     panel = page.get_by_role("region", name="Properties")
 
     def commit(label: str, value: str) -> None:
@@ -598,7 +519,7 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
         field.fill(value)
         field.press("Tab")
 
-    _select(page, "tc2")
+    select_element(page, "tc2")
     expect(panel.get_by_role("heading", name="Cobot task")).to_be_visible()
     commit("Instructions", "Place the insert in the fixture.")
     panel.get_by_label("Program", exact=True).fill("Assembly")
@@ -614,14 +535,14 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
     ).to_be_visible()
     screenshot(page, "editor-properties-cobot-task")
 
-    _select(page, "tc3")
+    select_element(page, "tc3")
     panel.get_by_label("Runs").select_option("device")
     # The calls offered are the engine's (taskconfig.DEVICE_CALLS), passed by the page.
     expect(panel.get_by_label("Device call").locator("option")).to_have_count(len(DEVICE_CALLS))
     panel.get_by_label("Device call").select_option("display.show")
     commit("Argument text", "=data.message")
 
-    _select(page, "to2")
+    select_element(page, "to2")
     expect(panel.get_by_role("heading", name="Operator task")).to_be_visible()
     panel.get_by_role("button", name="Add a form field").click()
     commit("Name", "insert_ok")
@@ -629,7 +550,7 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
     panel.get_by_label("Type").select_option("boolean")
     panel.get_by_label("required").check()
 
-    _select(page, "p1")
+    select_element(page, "p1")
     commit("Label", "workpiece arrives")
     page.get_by_role("button", name="Save", exact=True).click()
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text("Saved.", timeout=CHECKED)
@@ -658,7 +579,7 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
     # What the editor does not know travels unchanged.
     assert pattern.draft["source"] == "thesis, section 4.3.1, CP_synch_1O1C"
     # The server checks the configuration as part of the model.
-    expect(_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
 
 
 def test_keys_select_copy_paste_delete_and_undo(
@@ -666,11 +587,11 @@ def test_keys_select_copy_paste_delete_and_undo(
 ) -> None:
     pattern = _assembly(organisation)
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     shapes = page.locator(".djs-shape")
     count = shapes.count()
 
-    lane = _box(page, "o")
+    lane = element_box(page, "o")
     page.mouse.click(lane["x"] + 10, lane["y"] + lane["height"] / 2)  # on the lane's header
     page.keyboard.press("Delete")
     expect(page.locator(".hrc-refusal")).to_have_text(
@@ -678,10 +599,10 @@ def test_keys_select_copy_paste_delete_and_undo(
     )
     expect(shapes).to_have_count(count)
 
-    _select(page, "tc1")
+    select_element(page, "tc1")
     page.keyboard.press("Control+c")
     page.keyboard.press("Control+v")
-    lane = _box(page, "c")
+    lane = element_box(page, "c")
     # Free space at the end of the cobot's lane: the copy stays the cobot's.
     x, y = lane["x"] + lane["width"] - 30, lane["y"] + lane["height"] / 2
     page.mouse.move(x, y, steps=6)
@@ -707,18 +628,24 @@ def test_a_lane_moves_up_with_its_tasks_and_one_undo_puts_it_back(
 ) -> None:
     pattern = _assembly(organisation)  # lanes c (the cobot's) above o
     sign_in(page, engineer)
-    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     panel = page.get_by_role("region", name="Properties")
-    cobot, operator, operator_task = _box(page, "c"), _box(page, "o"), _box(page, "to1")
+    cobot, operator, operator_task = (
+        element_box(page, "c"),
+        element_box(page, "o"),
+        element_box(page, "to1"),
+    )
     assert cobot["y"] < operator["y"]
 
     page.mouse.click(operator["x"] + 10, operator["y"] + operator["height"] / 2)
     expect(panel.get_by_role("button", name="Move lane down")).to_be_disabled()
     panel.get_by_role("button", name="Move lane up").click()
-    _until(lambda: abs(_box(page, "o")["y"] - cobot["y"]) < 2)
-    assert abs(_box(page, "c")["y"] - operator["y"]) < 2  # both lanes are as tall
+    until(lambda: abs(element_box(page, "o")["y"] - cobot["y"]) < 2)
+    assert abs(element_box(page, "c")["y"] - operator["y"]) < 2  # both lanes are as tall
     # The operator's task went up with its lane, and is still the operator's.
-    assert abs(_box(page, "to1")["y"] - (operator_task["y"] - (operator["y"] - cobot["y"]))) < 2
+    assert (
+        abs(element_box(page, "to1")["y"] - (operator_task["y"] - (operator["y"] - cobot["y"]))) < 2
+    )
     expect(panel.get_by_role("button", name="Move lane up")).to_be_disabled()
     page.get_by_role("button", name="Save", exact=True).click()
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text("Saved.", timeout=CHECKED)
@@ -731,6 +658,6 @@ def test_a_lane_moves_up_with_its_tasks_and_one_undo_puts_it_back(
     }  # fmt: skip
 
     page.keyboard.press("Control+z")  # the whole swap, lanes and tasks
-    _until(lambda: _near(_box(page, "o"), operator))
-    assert _near(_box(page, "c"), cobot)
-    assert _near(_box(page, "to1"), operator_task)
+    until(lambda: near(element_box(page, "o"), operator))
+    assert near(element_box(page, "c"), cobot)
+    assert near(element_box(page, "to1"), operator_task)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import http.cookiejar
+import json
 import os
 import re
 import shlex
@@ -24,7 +25,7 @@ import urllib.parse
 import urllib.request
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Self
+from typing import Any, Self
 from urllib.parse import urlsplit, urlunsplit
 
 from hrc.cobots.gateway.launcher import ROOT, free_port
@@ -106,6 +107,25 @@ class DemoRun:
     def passwords(self) -> dict[str, str]:
         """User name → password, as the demo printed them."""
         return dict(PASSWORD_LINE.findall(self.output()))
+
+    def token(self, username: str, password: str | None = None) -> str:
+        """An API token for the person (their printed password unless another is given)."""
+        secret = password if password is not None else self.passwords()[username]
+        body = json.dumps({"username": username, "password": secret}).encode()
+        request = urllib.request.Request(
+            f"{self.url}/api/token/", data=body, headers={"Content-Type": "application/json"}
+        )
+        with urllib.request.urlopen(request, timeout=30) as response:
+            return str(json.load(response)["token"])
+
+    def get(self, token: str, path: str) -> dict[str, Any]:
+        """The API's JSON answer at `path`, read with the token."""
+        request = urllib.request.Request(
+            f"{self.url}{path}", headers={"Authorization": f"Token {token}"}
+        )
+        with urllib.request.urlopen(request, timeout=30) as response:
+            answer: dict[str, Any] = json.load(response)
+            return answer
 
     def started_cases(self) -> dict[str, int]:
         """Pattern name → id of each case the banner says the demo started."""
