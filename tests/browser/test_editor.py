@@ -151,7 +151,7 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     deadlock.get_by_role("button", name="Play the witness").click()
     bar = page.get_by_role("toolbar", name="Token game")
     for _ in range(3):
-        bar.get_by_role("button", name="Forward ▶").click()
+        bar.get_by_role("button", name="Next witness step ▶").click()
     expect(bar.locator(".hrc-game-caption")).to_contain_text("Witness replayed (3 of 3)")
     # Where the witness ends: tc1 has completed, tc2 and to1 wait for each other.
     expect(page.locator('.djs-element[data-element-id="tc1"]')).not_to_have_class(RUNNING)
@@ -385,8 +385,8 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
         return page.locator(f'.djs-element[data-element-id="{place}"] .hrc-token')
 
     expect(tokens("p1")).to_have_count(1)
-    click_element(page, "tc1")  # not enabled yet: nothing happens
-    expect(caption).to_have_text("Enabled: t1.")
+    click_element(page, "tc1")  # not enabled yet: nothing fires, the caption says why
+    expect(caption).to_have_text(re.compile(r"is held back: .+ has no token yet\.$"))
     click_element(page, "t1")
     expect(tokens("p1")).to_have_count(0)
     expect(tokens("p2")).to_have_count(1)
@@ -402,11 +402,12 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
     expect(page.locator(".hrc-constraint-place", has_text="to1 done, for tc2: 0")).to_be_visible()
     click_element(page, "tc2")
     expect(page.locator('.djs-element[data-element-id="tc2"]')).not_to_have_class(RUNNING)
+    expect(caption).to_contain_text("the time constraint waits for")
     screenshot(page, "editor-token-game")
 
-    bar.get_by_role("button", name="◀ Back").click()
+    bar.get_by_role("button", name="◀ Undo firing").click()
     expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
-    bar.get_by_role("button", name="Forward ▶").click()
+    bar.get_by_role("button", name="Redo firing ▶").click()
     expect(tokens("p3")).to_have_count(1)
 
     bar.get_by_role("button", name="Run randomly").click()

@@ -113,6 +113,22 @@ describe("the token game", () => {
   });
 });
 
+describe("what holds a task back", () => {
+  test("names the constraint and the task it waits for, or the place without a token", () => {
+    const game = new TokenGame(handOver("tc1>to1"));
+    game.fire("t1");
+    expect(game.heldBack("to1")).toEqual([{ kind: "constraint", type: "time", waitsFor: "tc1" }]);
+    expect(game.heldBack("tc1")).toEqual([{ kind: "flow", place: "p2" }]);
+    expect(game.heldBack("t1")).toEqual([{ kind: "flow", place: "p0" }]);
+  });
+
+  test("is nothing for a task that can fire", () => {
+    const game = new TokenGame(handOver());
+    game.fire("t1");
+    expect(game.heldBack("to1")).toEqual([]);
+  });
+});
+
 describe("reading the server's execution net", () => {
   test("fills in kinds and owners from the ids when the answer leaves them out", () => {
     const net = readExecutionNet({

@@ -109,7 +109,7 @@ describe("cell words", () => {
 describe("giving a task back", () => {
   it("is offered on a task the operator claimed and has not started, and on no other", () => {
     const state = floor("");
-    const mine = { ...item(101, 10), state: "claimed", claimed_by: state.user.id };
+    const mine = item({ id: 101, case: 10, state: "claimed", claimed_by: state.user.id });
     expect(mayGiveBack(state, mine)).toBe(true);
     expect(mayGiveBack(state, { ...mine, state: "running" })).toBe(false);
     expect(mayGiveBack(state, { ...mine, claimed_by: state.user.id + 1 })).toBe(false);

@@ -82,6 +82,9 @@ function ofList(of: unknown, id: string, kind: PlaceKind): string[] {
 
 export type Marking = Map<string, number>;
 
+/** What holds a task back in the token game: a constraint waiting for another task, or an empty place. */
+export type HeldBack = { kind: "constraint"; type: string; waitsFor: string } | { kind: "flow"; place: string };
+
 /** The token game: a marking, the firings that led to it, and the ones undone (to step forward again). */
 export class TokenGame {
   readonly net: ExecutionNet;
@@ -164,6 +167,30 @@ export class TokenGame {
     const candidates = this.net.transitions.filter((t) => t.task === task && this.isEnabled(t));
     const order: FiringKind[] = ["silent", "complete", "start"];
     return order.map((kind) => candidates.find((t) => t.kind === kind)).find((t) => t !== undefined) ?? null;
+  }
+
+  /**
+   * Why a pattern task can neither start nor complete now: for each of its firings, the input
+   * places that lack a token. A constraint place names the constraint's type and the task at its
+   * other end, which has to happen first; a flow place is the model's own order. Empty when the
+   * task can fire.
+   */
+  heldBack(task: string): HeldBack[] {
+    if (this.firingFor(task)) return [];
+    const firings = this.net.transitions.filter((t) => t.task === task && t.kind !== "complete");
+    const reasons = new Map<string, HeldBack>();
+    for (const firing of firings) {
+      for (const [placeId, weight] of this.pre.get(firing.id) ?? []) {
+        if (this.tokens(placeId) >= weight) continue;
+        const place = this.net.places.find((p) => p.id === placeId);
+        if (!place || place.kind === "busy") continue;
+        if (place.kind === "constraint") {
+          const other = place.of.find((element) => element !== task) ?? place.of[0];
+          reasons.set(placeId, { kind: "constraint", type: placeId.slice(0, placeId.indexOf(":")) || "constraint", waitsFor: other });
+        } else reasons.set(placeId, { kind: "flow", place: place.of[0] ?? placeId });
+      }
+    }
+    return [...reasons.values()];
   }
 
   /** Whether a pattern task is running (its busy place holds a token). */

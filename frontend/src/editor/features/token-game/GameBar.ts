@@ -25,8 +25,10 @@ export default class GameBar {
       this.bar.appendChild(button);
       return button;
     };
-    add("◀ Back", () => tokenGame.back());
-    add("Forward ▶", () => tokenGame.forward());
+    // Undo and redo move through the firings made; while a witness is replayed, "next step"
+    // fires its next firing. Firing itself is a click on a task.
+    add("◀ Undo firing", () => tokenGame.back());
+    const forward = add("Redo firing ▶", () => tokenGame.forward());
     add("Run randomly", () => tokenGame.runRandomly());
     add("Reset", () => tokenGame.reset());
     const toggle = document.createElement("label");
@@ -45,6 +47,9 @@ export default class GameBar {
       this.bar.hidden = true;
       box.checked = false;
     });
-    eventBus.on("tokenGame.changed", (event: { caption: string }) => (this.caption.textContent = event.caption));
+    eventBus.on("tokenGame.changed", (event: { caption: string }) => {
+      this.caption.textContent = event.caption;
+      forward.textContent = tokenGame.replaying ? "Next witness step ▶" : "Redo firing ▶";
+    });
   }
 }

@@ -85,15 +85,42 @@ export default class TokenGameMode {
     this.eventBus.fire("tokenGame.stopped", {});
   }
 
-  /** What a click on a node does: fire the task's completion, its start, or the silent transition. */
+  /** What a click on a node does: fire the task's completion, its start, or the silent transition;
+   * on a task that cannot fire, the caption says what holds it back. */
   fireTask(id: string): NetTransition | null {
     const game = this.game;
-    const firing = game?.firingFor(id) ?? null;
-    if (!game || !firing) return null;
+    if (!game) return null;
+    const firing = game.firingFor(id);
+    if (!firing) {
+      if (objectOf(this.elementRegistry.get(id))?.kind === "transition") {
+        this.eventBus.fire("tokenGame.changed", { caption: this.heldBackCaption(game, id) });
+      }
+      return null;
+    }
     game.fire(firing.id);
     this.replaying = null;
     this.render();
     return firing;
+  }
+
+  /** The caption for a click on a task that cannot fire, in the drawing's words. */
+  heldBackCaption(game: TokenGame, id: string): string {
+    const reasons = game.heldBack(id);
+    const task = this.nameOf(id);
+    if (reasons.length === 0) return `${task} cannot fire now.`;
+    const words = reasons.map((reason) =>
+      reason.kind === "constraint"
+        ? `the ${reason.type.replace(/-.*/, "")} constraint waits for ${this.nameOf(reason.waitsFor)}`
+        : `${this.nameOf(reason.place)} has no token yet`,
+    );
+    return `${task} is held back: ${words.join("; ")}.`;
+  }
+
+  private nameOf(id: string): string {
+    const object = objectOf(this.elementRegistry.get(id));
+    const data = object && "data" in object ? (object.data as { label?: unknown }) : undefined;
+    const label = typeof data?.label === "string" ? data.label.trim() : "";
+    return label ? `“${label}”` : id;
   }
 
   back(): void {
