@@ -14,6 +14,8 @@ of the row, so none hides another.
 from __future__ import annotations
 
 import datetime as dt
+import itertools
+import statistics
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -240,6 +242,12 @@ CHAR_WIDTH = 6.6  # an estimate for 12 px system-ui, to decide whether a label f
 # Tick spacings in seconds: the smallest that gives at most MAX_TICKS ticks is used.
 TICK_STEPS = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 14400, 28800, 86400)
 MAX_TICKS = 10
+MIN_TICK_GAP = 44  # pixels between two tick labels
+# A stretch of time in which nothing starts or ends is drawn shorter when it is longer than
+# BREAK_FACTOR times the median stretch (and than MIN_BREAK_SECONDS): one long step or wait then
+# no longer squeezes every other bar to a sliver. The axis shows the break and what it left out.
+BREAK_FACTOR = 4.0
+MIN_BREAK_SECONDS = 5.0
 
 
 @dataclass(frozen=True)
@@ -315,6 +323,72 @@ class Tick:
 
 
 @dataclass(frozen=True)
+class AxisBreak:
+    """Where the axis is broken: the x of the break and the seconds it leaves out."""
+
+    x: float
+    seconds: float
+
+
+@dataclass(frozen=True)
+class TimeAxis:
+    """Time to x, piecewise: each stretch between two moments at its length, a long empty one
+    shortened to the cap (a broken axis)."""
+
+    left: float
+    scale: float
+    stretches: tuple[tuple[float, float, float], ...]
+    """(from, to, shown): real seconds since the start, and the seconds it is drawn as."""
+
+    @classmethod
+    def over(cls, span: float, moments: Iterable[float], left: float, right: float) -> TimeAxis:
+        cuts = sorted({0.0, span, *(min(max(m, 0.0), span) for m in moments)})
+        gaps = [b - a for a, b in itertools.pairwise(cuts) if b > a]
+        cap = max(BREAK_FACTOR * statistics.median(gaps), MIN_BREAK_SECONDS) if gaps else span
+        stretches = tuple(
+            (a, b, b - a if b - a <= cap else cap) for a, b in itertools.pairwise(cuts) if b > a
+        )
+        shown = sum(stretch[2] for stretch in stretches) or 1.0
+        return cls(left, (right - left) / shown, stretches)
+
+    def x(self, offset: float) -> float:
+        """Where `offset` seconds after the start are drawn."""
+        x = self.left
+        for start, end, shown in self.stretches:
+            if offset >= end:
+                x += shown * self.scale
+                continue
+            if offset > start:
+                x += (offset - start) / (end - start) * shown * self.scale
+            break
+        return x
+
+    @property
+    def breaks(self) -> list[AxisBreak]:
+        return [
+            AxisBreak(self.x((start + end) / 2), end - start - shown)
+            for start, end, shown in self.stretches
+            if end - start > shown
+        ]
+
+    def ticks(self, span: float) -> list[Tick]:
+        """Ticks at round offsets, none inside a break, none crowding the one before."""
+        shown = sum(stretch[2] for stretch in self.stretches)
+        step = next((s for s in TICK_STEPS if shown / s <= MAX_TICKS), TICK_STEPS[-1])
+        broken = [(a, b) for a, b, drawn in self.stretches if b - a > drawn]
+        ticks: list[Tick] = []
+        for n in range(int(span // step) + 1):
+            offset = n * step
+            if any(a < offset < b for a, b in broken):
+                continue
+            x = self.x(offset)
+            if ticks and x - ticks[-1].x < MIN_TICK_GAP:
+                continue
+            ticks.append(Tick(x, format_offset(offset)))
+        return ticks
+
+
+@dataclass(frozen=True)
 class GanttDrawing:
     gantt: Gantt
     width: float
@@ -329,6 +403,7 @@ class GanttDrawing:
     ticks: list[Tick]
     now_x: float | None
     """Where now is, while the case is open."""
+    breaks: list[AxisBreak]
 
     @property
     def tick_y(self) -> float:
@@ -343,10 +418,10 @@ def draw_gantt(gantt: Gantt, width: float = 1100) -> GanttDrawing:
     """The chart laid out `width` pixels wide, time running left to right."""
     right = width - RIGHT_MARGIN
     span = max(seconds(gantt.start, gantt.end), 1.0)
-    scale = (right - LABEL_WIDTH) / span
+    axis = TimeAxis.over(span, _moments(gantt), LABEL_WIDTH, right)
 
     def x_of(moment: dt.datetime) -> float:
-        return LABEL_WIDTH + max(0.0, min(seconds(gantt.start, moment), span)) * scale
+        return axis.x(seconds(gantt.start, moment))
 
     rows, bars, y = [], {}, float(TOP)
     for index, row in enumerate(gantt.rows):
@@ -396,9 +471,25 @@ def draw_gantt(gantt: Gantt, width: float = 1100) -> GanttDrawing:
         bars=list(bars.values()),
         arrows=arrows,
         marks=marks,
-        ticks=_ticks(span, scale),
+        ticks=axis.ticks(span),
         now_x=x_of(gantt.now) if gantt.open else None,
+        breaks=axis.breaks,
     )
+
+
+def _moments(gantt: Gantt) -> list[float]:
+    """Every offset at which something starts or ends on the chart."""
+    moments = []
+    for row in gantt.rows:
+        for bar in row.bars:
+            for moment in (bar.offered_at, bar.started_at, bar.until(gantt.now)):
+                if moment is not None:
+                    moments.append(seconds(gantt.start, moment))
+    for mark in gantt.marks:
+        moments += [seconds(gantt.start, m) for m in (mark.started_at, mark.ended_at) if m]
+    if gantt.open:
+        moments.append(seconds(gantt.start, gantt.now))
+    return moments
 
 
 def _drawn_bar(bar: Bar, y: float, x_of: _XOf, now: dt.datetime) -> DrawnBar:
@@ -435,12 +526,6 @@ def _arrow_path(source: DrawnBar, target: DrawnBar, x1: float, x2: float) -> str
         return f"M {x1:.1f} {source.middle:.1f} H {x2:.1f} V {into:.1f}"
     out = source.y + BAR_HEIGHT if down else source.y
     return f"M {x1:.1f} {out:.1f} V {into:.1f}"
-
-
-def _ticks(span: float, scale: float) -> list[Tick]:
-    step = next((s for s in TICK_STEPS if span / s <= MAX_TICKS), TICK_STEPS[-1])
-    count = int(span // step)
-    return [Tick(LABEL_WIDTH + n * step * scale, format_offset(n * step)) for n in range(count + 1)]
 
 
 def format_offset(total: float) -> str:

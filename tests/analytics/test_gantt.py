@@ -195,3 +195,39 @@ def test_offsets_read_as_minutes_and_seconds_then_hours() -> None:
         "1:00:00",
         "2:02:05",
     ]
+
+
+def test_a_long_stretch_with_nothing_happening_is_drawn_shorter_on_a_broken_axis() -> None:
+    # Three short steps, then one that takes ten minutes: drawn to scale, the short ones
+    # would be slivers of a pixel or two.
+    gantt = build_gantt(
+        1, started_at=at(0), ended_at=at(612), now=at(700), actors=ACTORS,
+        items=[item(1, "tc1", "c", 0, 0, 4), item(2, "to1", "o", 4, 5, 8),
+               item(3, "tc2", "c", 8, 8, 608), item(4, "to2", "o", 608, 609, 612)],
+        constraints=[], interruptions=[],
+    )  # fmt: skip
+    drawing = draw_gantt(gantt, width=1000 + LABEL_WIDTH + RIGHT_MARGIN)
+    bars = {b.bar.work_item: b for b in drawing.bars}
+    assert bars[1].width > 60  # to scale it would be 1000 / 612 * 4 ≈ 6.5 px
+    assert bars[3].width < 10 * bars[1].width  # the long one no longer takes the chart
+    (cut,) = drawing.breaks
+    assert bars[3].x is not None
+    assert bars[3].x < cut.x < bars[3].x + bars[3].width
+    assert cut.seconds == pytest.approx(600 - 4 * 3)  # shown as four times the median stretch
+    # Time still runs left to right, and no tick falls inside the break.
+    xs = [bars[n].x for n in (1, 2, 3, 4)]
+    assert xs == sorted(xs)
+    assert all(abs(t.x - cut.x) > 1 for t in drawing.ticks)
+    assert drawing.ticks[0].label == "0:00"
+    assert drawing.ticks[-1].label == "10:10"
+
+
+def test_a_chart_without_a_long_empty_stretch_keeps_its_scale() -> None:
+    gantt = build_gantt(
+        1, started_at=at(0), ended_at=at(30), now=at(30), actors=ACTORS,
+        items=[item(1, "tc1", "c", 0, 0, 10), item(2, "to1", "o", 10, 12, 30)],
+        constraints=[], interruptions=[],
+    )  # fmt: skip
+    drawing = draw_gantt(gantt, width=300 + LABEL_WIDTH + RIGHT_MARGIN)
+    assert drawing.breaks == []
+    assert drawing.bars[0].width == pytest.approx(100)
