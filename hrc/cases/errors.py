@@ -6,9 +6,14 @@ class CaseError(Exception):
 
 
 class Invalid(CaseError):
-    """The input is wrong (400); the message names what."""
+    """The input is wrong (400); the message names what. `fields` holds the messages by field
+    (DRF's shape, `{"name": ["message"]}`), so a form can show each at its field."""
 
     status = 400
+
+    def __init__(self, message: str, fields: dict[str, list[str]] | None = None) -> None:
+        super().__init__(message)
+        self.fields = fields or {}
 
 
 class NotAllowed(CaseError):

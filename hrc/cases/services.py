@@ -267,15 +267,34 @@ def complete_work_item(
 
 
 def _check_form(config: TaskConfig, data: Mapping[str, Any]) -> None:
+    """Invalid, naming each field the form refuses: a required answer that is missing too.
+    The data is stored as given: nothing is filled in for a field the operator left out."""
     if config.form is None:
         return
     validator = jsonschema.Draft202012Validator(config.form)
-    problems = sorted(validator.iter_errors(data), key=lambda e: list(e.absolute_path))
-    if problems:
+    fields: dict[str, list[str]] = {}
+    for problem in sorted(validator.iter_errors(data), key=lambda e: list(e.absolute_path)):
+        for name, message in _form_problems(problem):
+            fields.setdefault(name, []).append(message)
+    if fields:
         raise Invalid(
             "The form is not filled in correctly: "
-            + "; ".join(f"{_field(p.absolute_path)}: {p.message}" for p in problems)
+            + "; ".join(f"{name}: {message}" for name, messages in fields.items() for message in messages),
+            fields,
         )
+
+
+def _form_problems(problem: jsonschema.ValidationError) -> list[tuple[str, str]]:
+    """(field, message) for one refusal; a missing required answer is named by its field, not
+    reported against the form as a whole."""
+    path = list(problem.absolute_path)
+    if problem.validator == "required" and isinstance(problem.instance, Mapping):
+        return [
+            (_field([*path, name]), "an answer is required")
+            for name in problem.validator_value
+            if name not in problem.instance
+        ]
+    return [(_field(path), problem.message)]
 
 
 def _field(path: Iterable[Any]) -> str:
