@@ -5,7 +5,7 @@ import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
 import { ApiError, request } from "./api";
-import { type FormSchema, renderForm } from "./form";
+import { buildForm, type FormSchema } from "./form";
 import {
   activity,
   atThisCell,
@@ -15,6 +15,7 @@ import {
   degrees,
   elsewhere,
   humanSafety,
+  mayGiveBack,
   myTasks,
   nextAction,
   teamTasks,
@@ -114,18 +115,24 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     }
     article.append(list);
   }
+  const actions = element("div", "card-actions");
   const action = nextAction(state, item);
-  if (action) {
-    const button = element("button", `action ${action === "complete" ? "primary" : ""}`, label(action));
-    button.dataset.action = action;
-    button.dataset.item = String(item.id);
-    article.append(button);
-  }
+  if (action) actions.append(actionButton(item, action, `action ${action === "complete" ? "primary" : ""}`));
+  if (mayGiveBack(state, item)) actions.append(actionButton(item, "unclaim", "give-back"));
+  if (actions.childElementCount) article.append(actions);
   return article;
 }
 
+function actionButton(item: WorkItemData, action: string, className: string): HTMLButtonElement {
+  const button = element("button", className, label(action));
+  button.type = "button";
+  button.dataset.action = action;
+  button.dataset.item = String(item.id);
+  return button;
+}
+
 function label(action: string): string {
-  return { claim: "Claim", start: "Start", complete: "Complete…" }[action] ?? action;
+  return { claim: "Claim", start: "Start", complete: "Complete…", unclaim: "Give back" }[action] ?? action;
 }
 
 function renderCobots(state: LiveState): void {
@@ -260,7 +267,7 @@ async function openForm(id: number): Promise<void> {
   form.method = "dialog";
   form.noValidate = true; // the server checks the form and names each field it refuses
   const fields = element("div", "fields");
-  const read = renderForm(fields, detail.form);
+  const answers = buildForm(fields, detail.form);
   const error = element("p", "errors");
   error.setAttribute("role", "alert");
   const cancel = element("button", "", "Cancel");
@@ -273,12 +280,23 @@ async function openForm(id: number): Promise<void> {
   form.append(element("h2", "", detail.label), element("p", "instructions", detail.instructions), fields, error, actions);
   form.addEventListener("submit", async (event) => {
     event.preventDefault();
+    error.textContent = "";
+    // Required answers are asked for here, at their fields; the server refuses them too.
+    if (!answers.check()) {
+      error.textContent = "Answer the questions marked above.";
+      return;
+    }
     submit.disabled = true;
     try {
-      await request("POST", `/api/work-items/${id}/complete/`, { data: read() });
+      await request("POST", `/api/work-items/${id}/complete/`, { data: answers.values() });
       dialog.close();
     } catch (failure) {
-      error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+      if (failure instanceof ApiError && Object.keys(failure.fields).length) {
+        const rest = answers.showErrors(failure.fields);
+        error.textContent = rest.length ? rest.join(" ") : "Correct the answers marked above.";
+      } else {
+        error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+      }
     } finally {
       submit.disabled = false;
     }

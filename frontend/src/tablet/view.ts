@@ -117,6 +117,12 @@ export function nextAction(state: LiveState, item: WorkItemData): "claim" | "sta
   return null;
 }
 
+/** Whether the user may give the task back to its team or candidates: they claimed it and have
+ * not started it. A started task stays with whoever started it (an engineer can reassign it). */
+export function mayGiveBack(state: LiveState, item: WorkItemData): boolean {
+  return item.state === "claimed" && item.claimed_by === state.user.id;
+}
+
 /** Joint angles in degrees, for the panel. */
 export function degrees(joints: number[]): number[] {
   return joints.map((value) => Math.round((value * 180) / Math.PI));
