@@ -11,7 +11,7 @@ import {
   atThisCell,
   cellsOf,
   cellWords,
-  cobotsOf,
+  cobotWork,
   degrees,
   elsewhere,
   humanSafety,
@@ -107,12 +107,10 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     article.append(element("p", "away", `At ${where}: go there to do it.`));
   }
   if (item.instructions) article.append(element("p", "instructions", item.instructions));
-  const cobots = cobotsOf(state, item);
-  if (cobots.length) {
+  const work = cobotWork(state, item);
+  if (work.length) {
     const list = element("ul", "with-cobots");
-    for (const cobot of cobots) {
-      list.append(element("li", "", `${cobot.name}: ${activity(cobot)}`));
-    }
+    list.append(...work.map((line) => element("li", "", line)));
     article.append(list);
   }
   const actions = element("div", "card-actions");

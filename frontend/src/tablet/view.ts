@@ -86,22 +86,42 @@ export function cobotsOf(state: LiveState, item: WorkItemData): CobotData[] {
   return ids.map((id) => state.cobots.get(id)).filter((c): c is CobotData => c !== undefined);
 }
 
+/** One line per cobot of the task's case: what it is doing for this case. Its work for another
+ * case is not this task's, so the card says only that the cobot is busy with another case. */
+export function cobotWork(state: LiveState, item: WorkItemData): string[] {
+  return cobotsOf(state, item).map((cobot) => `${cobot.name}: ${workFor(cobot, item.case)}`);
+}
+
+function workFor(cobot: CobotData, caseId: number): string {
+  const current = cobot.queue.current;
+  if (!current || current.case === caseId) return activity(cobot);
+  // A STOP, a fault or a lost connection is the cell's news, whichever case the cobot serves.
+  return trouble(cobot) ?? "busy with another case";
+}
+
 /** One line: what the cobot is doing right now, or waiting for. */
 export function activity(cobot: CobotData): string {
+  const problem = trouble(cobot);
+  if (problem) return problem;
+  const current = cobot.queue.current;
+  if (current) {
+    const step = current.step !== null ? ` (step ${current.step})` : "";
+    const paused = cobot.state?.program_state === "Paused" ? ", paused" : "";
+    return `${current.label || current.task}${step}, case ${current.case}${paused}`;
+  }
+  if (cobot.queue.waiting_for) return `waiting: ${cobot.queue.waiting_for}`;
+  return cobot.queue.queue_length ? `${cobot.queue.queue_length} queued` : "idle";
+}
+
+/** What keeps the cobot from working, whatever it works on; null when nothing does. */
+function trouble(cobot: CobotData): string | null {
   const state = cobot.state;
   if (cobot.stopped) return "held by STOP";
   if (state && !state.reachable) return `unreachable${state.error ? `: ${state.error}` : ""}`;
   if (state && !["SAFETY_MODE_NORMAL", "SAFETY_MODE_REDUCED"].includes(state.safety_mode)) {
     return `${humanSafety(state.safety_mode)}: clear it at the robot`;
   }
-  const current = cobot.queue.current;
-  if (current) {
-    const step = current.step !== null ? ` (step ${current.step})` : "";
-    const paused = state?.program_state === "Paused" ? ", paused" : "";
-    return `${current.label || current.task}${step}, case ${current.case}${paused}`;
-  }
-  if (cobot.queue.waiting_for) return `waiting: ${cobot.queue.waiting_for}`;
-  return cobot.queue.queue_length ? `${cobot.queue.queue_length} queued` : "idle";
+  return null;
 }
 
 export function humanSafety(mode: string): string {

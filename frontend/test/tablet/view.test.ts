@@ -1,7 +1,7 @@
 import { describe, expect, it } from "vitest";
 import type { Snapshot } from "../../src/live/events";
 import { type LiveState, LiveStore } from "../../src/live/store";
-import { atThisCell, cellsOf, cellWords, elsewhere, myTasks, teamTasks } from "../../src/tablet/view";
+import { atThisCell, cellsOf, cellWords, cobotWork, elsewhere, myTasks, teamTasks } from "../../src/tablet/view";
 import { item, snapshot } from "../live/fixtures";
 
 const WELD_ARM = {
@@ -103,5 +103,41 @@ describe("cell words", () => {
     expect(cellWords(["assembly", "paint", "weld"], true)).toBe("the assembly, paint and weld cells");
     expect(cellWords([])).toBe("another cell");
     expect(cellWords([], true)).toBe("other cells");
+  });
+});
+
+describe("a task card's cobots", () => {
+  const busy = (caseId: number, extra: object = {}) => ({
+    ...WELD_ARM,
+    ...extra,
+    queue: {
+      ...WELD_ARM.queue,
+      queue_length: 1,
+      current: { case: caseId, work_item: 900, task: "tc1", label: "weld the seam", kind: "step", step: 2, attempt: 1 },
+    },
+  });
+  const state = (cobot: object) =>
+    floor("weld", {
+      cases: [
+        { id: 10, seq: 2, status: "running", name: "Weld", cobots: [5] },
+        { id: 14, seq: 2, status: "running", name: "Weld", cobots: [5] },
+      ],
+      work_items: [item({ id: 101, case: 10 })],
+      cobots: [cobot as typeof WELD_ARM],
+    });
+
+  it("list the cobot's work for the task's own case", () => {
+    const here = state(busy(10));
+    expect(cobotWork(here, here.workItems.get(101)!)).toEqual(["weld-arm: weld the seam (step 2), case 10"]);
+  });
+
+  it("do not list the cobot's work for another case", () => {
+    const there = state(busy(14));
+    expect(cobotWork(there, there.workItems.get(101)!)).toEqual(["weld-arm: busy with another case"]);
+  });
+
+  it("still say the cobot is held by a STOP while it serves another case", () => {
+    const stopped = state(busy(14, { stopped: true }));
+    expect(cobotWork(stopped, stopped.workItems.get(101)!)).toEqual(["weld-arm: held by STOP"]);
   });
 });
