@@ -12,6 +12,7 @@ import {
   cellsOf,
   cellWords,
   cobotWork,
+  type DisplayMessage,
   degrees,
   elsewhere,
   humanSafety,
@@ -19,6 +20,7 @@ import {
   myTasks,
   nextAction,
   teamTasks,
+  withDisplayMessages,
 } from "./view";
 
 interface Config {
@@ -47,8 +49,7 @@ const socket = new LiveSocket({
   store,
   onStatus: showStatus,
 });
-const messages: Array<{ cobot: string; text: string; at: number }> = [];
-const lastDisplay = new Map<number, string>();
+let messages: DisplayMessage[] = [];
 let frame = 0;
 
 store.subscribe((event: LiveEvent) => {
@@ -198,15 +199,7 @@ function renderStop(state: LiveState): void {
 
 function collectMessages(): void {
   const state = store.state;
-  if (!state) return;
-  for (const cobot of state.cobots.values()) {
-    const text = cobot.state?.display ?? "";
-    if (text && lastDisplay.get(cobot.id) !== text) {
-      messages.unshift({ cobot: cobot.name, text, at: cobot.state!.at });
-      messages.length = Math.min(messages.length, MAX_MESSAGES);
-    }
-    lastDisplay.set(cobot.id, text);
-  }
+  if (state) messages = withDisplayMessages(messages, state.cobots.values(), MAX_MESSAGES);
 }
 
 function renderMessages(): void {
@@ -220,7 +213,7 @@ function renderMessages(): void {
       const item = element("li", "message");
       item.append(
         element("time", "", new Date(message.at * 1000).toLocaleTimeString()),
-        element("strong", "", message.cobot),
+        element("strong", "", message.name),
         element("span", "text", message.text),
       );
       return item;

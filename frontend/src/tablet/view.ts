@@ -143,6 +143,29 @@ export function mayGiveBack(state: LiveState, item: WorkItemData): boolean {
   return item.state === "claimed" && item.claimed_by === state.user.id;
 }
 
+/** A text a cobot's display showed, at the time it appeared there. */
+export interface DisplayMessage {
+  cobot: number;
+  name: string;
+  text: string;
+  at: number; // seconds since the epoch
+}
+
+/** `messages` with the texts the cobots' displays show now, newest first, at most `max`. A text
+ * is one message however often it is sent again (each state, each snapshot after a reconnect or
+ * a resync): it is known by its cobot and the time it appeared, and keeps that time. */
+export function withDisplayMessages(messages: DisplayMessage[], cobots: Iterable<CobotData>, max: number): DisplayMessage[] {
+  const known = new Set(messages.map((message) => `${message.cobot}@${message.at}`));
+  const added: DisplayMessage[] = [];
+  for (const cobot of cobots) {
+    const state = cobot.state;
+    if (!state?.display || known.has(`${cobot.id}@${state.display_at}`)) continue;
+    added.push({ cobot: cobot.id, name: cobot.name, text: state.display, at: state.display_at });
+  }
+  if (!added.length) return messages;
+  return [...added, ...messages].sort((a, b) => b.at - a.at).slice(0, max);
+}
+
 /** Joint angles in degrees, for the panel. */
 export function degrees(joints: number[]): number[] {
   return joints.map((value) => Math.round((value * 180) / Math.PI));
