@@ -279,7 +279,9 @@ def _check_form(config: TaskConfig, data: Mapping[str, Any]) -> None:
     if fields:
         raise Invalid(
             "The form is not filled in correctly: "
-            + "; ".join(f"{name}: {message}" for name, messages in fields.items() for message in messages),
+            + "; ".join(
+                f"{name}: {message}" for name, messages in fields.items() for message in messages
+            ),
             fields,
         )
 

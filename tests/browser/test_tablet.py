@@ -27,8 +27,8 @@ from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
 from hrc.patterns.models import PatternVersion
 from tests import factories
-from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.browser.conftest import assert_fits
+from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.live.server import LiveServer, MonitorProcess
 from tests.polling import until
 
@@ -203,7 +203,9 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     expect(dialog.locator('input[type="checkbox"]')).to_have_count(0)
     dialog.get_by_label("Parts in the tray *").fill("12")
     dialog.get_by_role("button", name="Complete").click()  # "clean" unanswered: refused here
-    expect(dialog.locator('[data-field="clean"] .field-error')).to_have_text("an answer is required")
+    expect(dialog.locator('[data-field="clean"] .field-error')).to_have_text(
+        "an answer is required"
+    )
     expect(dialog.locator('[data-field="parts"] .field-error')).to_be_hidden()
     screenshot(page, "tablet-form-refused")
     assert_fits(page)

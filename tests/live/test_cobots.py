@@ -215,7 +215,9 @@ def test_a_cell_the_organisation_does_not_have_cannot_be_stopped_or_resumed(
     client = APIClient()
     client.force_authenticate(operator)
 
-    refused = client.post(f"/api/cells/{action}/", {"cell": "cell1", "confirm": True}, format="json")
+    refused = client.post(
+        f"/api/cells/{action}/", {"cell": "cell1", "confirm": True}, format="json"
+    )
 
     assert refused.status_code == 400
     message = f"There is no cell 'cell1' in {organisation.name}."

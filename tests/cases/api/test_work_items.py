@@ -241,7 +241,9 @@ def test_a_completion_stores_exactly_the_answers_given(
     """No, given, is an answer; the optional fields left out stay out, default or not."""
     item = factories.open_work_item(answer_case, "count")
     _act(operator_client, item, "start")
-    response = _act(operator_client, item, "complete", {"data": {"seated": False, "quality": "NOK"}})
+    response = _act(
+        operator_client, item, "complete", {"data": {"seated": False, "quality": "NOK"}}
+    )
     assert response.status_code == 200, response.data
     item.refresh_from_db()
     assert item.result == {"seated": False, "quality": "NOK"}
