@@ -16,7 +16,7 @@ from rest_framework import exceptions, status
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
-from hrc.cases.errors import CaseError
+from hrc.cases.errors import CaseError, Invalid
 from hrc.engine import FormatError
 
 
@@ -58,7 +58,10 @@ def exception_handler(exc: Exception, context: dict[str, Any]) -> Response | Non
     if isinstance(exc, FormatError):
         exc = document_rejected(exc)
     if isinstance(exc, CaseError):  # Invalid 400, NotAllowed 403, Conflict 409
-        return Response({"detail": str(exc)}, status=exc.status)
+        body: dict[str, Any] = {"detail": str(exc)}
+        if isinstance(exc, Invalid) and exc.fields:
+            body["fields"] = exc.fields
+        return Response(body, status=exc.status)
     if isinstance(exc, Rejected):
         return Response(exc.payload, status=exc.status_code)
     if isinstance(exc, DjangoValidationError):

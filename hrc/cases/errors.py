@@ -6,13 +6,19 @@ class CaseError(Exception):
 
 
 class Invalid(CaseError):
-    """The input is wrong (400); the message names what, `field` where (a form shows it there)."""
+    """The input is wrong (400); the message names what. `fields` holds the messages by field
+    (DRF's shape, `{"name": ["message"]}`), so a form can show each at its field."""
 
     status = 400
 
-    def __init__(self, message: str, field: str | None = None) -> None:
+    def __init__(self, message: str, fields: dict[str, list[str]] | None = None) -> None:
         super().__init__(message)
-        self.field = field
+        self.fields = fields or {}
+
+    @classmethod
+    def at(cls, field: str, message: str) -> "Invalid":
+        """The refusal of one field's value (`data.batch`, `actor_mapping.o`)."""
+        return cls(message, {field: [message]})
 
 
 class NotAllowed(CaseError):

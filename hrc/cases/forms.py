@@ -148,9 +148,15 @@ class StartForm(CycleForm):
 
 
 def refuse(form: forms.Form, invalid: Invalid) -> None:
-    """Shows the services' refusal at the field it names (data.batch → data__batch), else above."""
-    field = (invalid.field or "").replace("actor_mapping.", "actor__").replace(".", "__")
-    form.add_error(field if field in form.fields else None, str(invalid))
+    """Shows the services' refusal at the fields it names (data.batch → data__batch), else above."""
+    shown = False
+    for name, messages in invalid.fields.items():
+        field = name.replace("actor_mapping.", "actor__").replace(".", "__")
+        if field in form.fields:
+            form.add_error(field, messages)
+            shown = True
+    if not shown:
+        form.add_error(None, str(invalid))
 
 
 def data_form_field(field: StartField) -> forms.Field:

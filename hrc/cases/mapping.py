@@ -25,19 +25,19 @@ def resolve_actor_mapping(
     """
     unknown = sorted(set(mapping) - {a.id for a in pattern.actors})
     if unknown:
-        raise Invalid(f"The pattern has no actor {', '.join(unknown)}.", "actor_mapping")
+        raise Invalid.at("actor_mapping", f"The pattern has no actor {', '.join(unknown)}.")
     resolved: dict[str, dict[str, Any]] = {}
     for actor in pattern.actors:
         binding = mapping.get(actor.id)
         if not isinstance(binding, Mapping) or not binding:
-            raise Invalid(
+            raise Invalid.at(
+                f"actor_mapping.{actor.id}",
                 f"Actor {actor.id} ({actor.type}) is not mapped: give "
                 + (
                     "{'cobot': id or name}."
                     if actor.type == "cobot"
                     else "{'users': [...]} or {'team': id or name}."
                 ),
-                f"actor_mapping.{actor.id}",
             )
         if actor.type == "cobot":
             resolved[actor.id] = {"cobot": _cobot(actor.id, organisation, binding)}
@@ -53,9 +53,9 @@ def _cobot(actor: str, organisation: Organisation, binding: Mapping[str, Any]) -
     cobots = Cobot.objects.filter(organisation=organisation, is_active=True)
     cobot = _by_id_or_name(cobots, reference, "name")
     if cobot is None:
-        raise Invalid(
-            f"Actor {actor}: the organisation has no active cobot {reference!r}.",
+        raise Invalid.at(
             f"actor_mapping.{actor}",
+            f"Actor {actor}: the organisation has no active cobot {reference!r}.",
         )
     return int(cobot.pk)
 
@@ -63,17 +63,18 @@ def _cobot(actor: str, organisation: Organisation, binding: Mapping[str, Any]) -
 def _team(actor: str, organisation: Organisation, reference: Any) -> int:
     team = _by_id_or_name(Team.objects.filter(organisation=organisation), reference, "name")
     if team is None:
-        raise Invalid(
-            f"Actor {actor}: the organisation has no team {reference!r}.", f"actor_mapping.{actor}"
+        raise Invalid.at(
+            f"actor_mapping.{actor}",
+            f"Actor {actor}: the organisation has no team {reference!r}.",
         )
     return int(team.pk)
 
 
 def _users(actor: str, organisation: Organisation, references: Any) -> list[int]:
     if not isinstance(references, list) or not references:
-        raise Invalid(
-            f"Actor {actor}: 'users' must be a non-empty list of user ids or names.",
+        raise Invalid.at(
             f"actor_mapping.{actor}",
+            f"Actor {actor}: 'users' must be a non-empty list of user ids or names.",
         )
     # A deactivated person signs in nowhere: a task offered to them would wait forever.
     members = get_user_model().objects.filter(
@@ -83,9 +84,9 @@ def _users(actor: str, organisation: Organisation, references: Any) -> list[int]
     for reference in references:
         user = _by_id_or_name(members, reference, "username")
         if user is None:
-            raise Invalid(
-                f"Actor {actor}: {reference!r} is not an active member of the organisation.",
+            raise Invalid.at(
                 f"actor_mapping.{actor}",
+                f"Actor {actor}: {reference!r} is not an active member of the organisation.",
             )
         ids.append(int(user.pk))
     return sorted(set(ids))

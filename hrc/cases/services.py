@@ -92,19 +92,21 @@ def start_cases(
 ) -> list[Case]:
     """Starts `count` cases alike, all or none (start_case's checks, once)."""
     if version.retired_at is not None:
-        raise Invalid(f"{version} is retired: it starts no new cases.", "version")
+        raise Invalid.at("version", f"{version} is retired: it starts no new cases.")
     if not 1 <= count <= MAX_CASES_AT_ONCE:
-        raise Invalid(f"Start between 1 and {MAX_CASES_AT_ONCE} cases at once.", "count")
+        raise Invalid.at("count", f"Start between 1 and {MAX_CASES_AT_ONCE} cases at once.")
     if len(reference) > REFERENCE_LENGTH:
-        raise Invalid(f"The reference is longer than {REFERENCE_LENGTH} characters.", "reference")
+        raise Invalid.at(
+            "reference", f"The reference is longer than {REFERENCE_LENGTH} characters."
+        )
     net = case_net(version)
     organisation = version.pattern.organisation
     mapping = {**(version.default_actor_mapping or {}), **(actor_mapping or {})}
     mapping = resolve_actor_mapping(net.pattern, organisation, mapping)
     if data is not None and not isinstance(data, Mapping):
-        raise Invalid("The case data must be a JSON object.", "data")
+        raise Invalid.at("data", "The case data must be a JSON object.")
     for key, problem in check_start_data(net.initial_data(), data or {}).items():
-        raise Invalid(problem, f"data.{key}")
+        raise Invalid.at(f"data.{key}", problem)
     cases = []
     with transaction.atomic():
         for _ in range(count):
@@ -309,25 +311,36 @@ def complete_work_item(
 
 
 def _check_form(config: TaskConfig, data: Mapping[str, Any]) -> None:
+    """Invalid, naming each field the form refuses: a required answer that is missing too.
+    The data is stored as given: nothing is filled in for a field the operator left out."""
     if config.form is None:
         return
     validator = jsonschema.Draft202012Validator(config.form)
-    problems = sorted(validator.iter_errors(data), key=lambda e: list(e.absolute_path))
-    if problems:
+    fields: dict[str, list[str]] = {}
+    for problem in sorted(validator.iter_errors(data), key=lambda e: list(e.absolute_path)):
+        for name, message in _form_problems(problem):
+            fields.setdefault(name, []).append(message)
+    if fields:
         raise Invalid(
             "The form is not filled in correctly: "
-            + "; ".join(_problem(config.form, p) for p in problems)
+            + "; ".join(
+                f"{name}: {message}" for name, messages in fields.items() for message in messages
+            ),
+            fields,
         )
 
 
-def _problem(form: Mapping[str, Any], problem: jsonschema.ValidationError) -> str:
-    # A required answer left out is named by the title the operator saw, not as a schema path.
+def _form_problems(problem: jsonschema.ValidationError) -> list[tuple[str, str]]:
+    """(field, message) for one refusal; a missing required answer is named by its field, not
+    reported against the form as a whole."""
+    path = list(problem.absolute_path)
     if problem.validator == "required" and isinstance(problem.instance, Mapping):
-        properties = form.get("properties", {})
-        missing = [name for name in problem.validator_value if name not in problem.instance]
-        titles = [str(properties.get(name, {}).get("title", name)) for name in missing]
-        return ", ".join(f"{title}: not answered" for title in titles)
-    return f"{_field(problem.absolute_path)}: {problem.message}"
+        return [
+            (_field([*path, name]), "an answer is required")
+            for name in problem.validator_value
+            if name not in problem.instance
+        ]
+    return [(_field(path), problem.message)]
 
 
 def _field(path: Iterable[Any]) -> str:

@@ -4,7 +4,9 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
 
 - `"task"` on a task (a transition with a performer):
   - operator tasks: `instructions` (text), `form` (a JSON Schema object the
-    completion's data must satisfy);
+    completion's data must satisfy; the data is stored as the operator gave
+    it: a required field has no value until answered, and a field's
+    `default` is only what the tablet shows filled in on an optional field);
   - cobot tasks, either a program step
     `"step": {"program": "Coexistence_PickAndPlace", "number": 2, "workspace": 0, "poses": [[x, y, z, rx, ry, rz]]}`
     or a device call `"device": {"call": "part-detection.scan", "args": {}}`;

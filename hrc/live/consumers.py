@@ -2,7 +2,8 @@
 selectors (who may watch, the snapshot) and broadcast (the deltas).
 
 On connect: refused (a `refused` event, then close 4401/4403) unless the
-session's user is a member of the organisation; then the socket joins its
+session's user is a member of the organisation, and (4404) when the cell is
+none of the organisation's; then the socket joins its
 groups and only then reads the snapshot (hrc.live.events explains why). Each
 event type has its handler; every send first re-checks that the event is the
 organisation's and the cell's, and that the user's membership still holds.
@@ -37,6 +38,7 @@ STATE_INTERVAL = 0.1
 CELL_SCOPED = frozenset({"cobot-state", "cobot-queue"})
 UNAUTHENTICATED = 4401
 FORBIDDEN = 4403
+NOT_FOUND = 4404
 
 
 class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # channels is untyped
@@ -66,6 +68,10 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             await self._refuse("You are not a member of this organisation.", FORBIDDEN)
             return
         access = self.access
+        if not await database_sync_to_async(selectors.is_cell)(access.organisation_id, self.cell):
+            # A mistyped cell would otherwise look live and show nothing to stop.
+            await self._refuse(f"There is no cell {self.cell!r} in this organisation.", NOT_FOUND)
+            return
         MEMBERSHIPS.watch(self)
         self.groups_joined = [
             broadcast.organisation_group(access.organisation_id),

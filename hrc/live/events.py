@@ -104,6 +104,7 @@ class CobotStateData(TypedDict):
     program: str
     joints: list[float]  # radians, base to wrist 3
     display: str  # the text on the cell's display device
+    display_at: float  # when that text appeared (seconds since the epoch): a message's time
     error: str  # why the gateway cannot be reached, or its last refusal
 
 

@@ -65,12 +65,27 @@ class Watched:
         self.state = {
             "cobot": self.cobot_id, "at": time.time(), "reachable": False, "robot_mode": "",
             "safety_mode": "", "program_state": "", "program": "", "joints": [], "display": "",
-            "error": "not connected yet",
+            "display_at": 0.0, "error": "not connected yet",
         }  # fmt: skip
 
     def update(self, **values: Any) -> None:
-        self.state = {**self.state, **values, "at": time.time()}  # type: ignore[typeddict-item]
+        at = time.time()
+        # The text's own time, kept while it stays: a reconnect or a resync shows it again
+        # with the time it appeared, not as a new message.
+        if "display" in values and values["display"] != self.state["display"]:
+            values["display_at"] = at
+        self.state = {**self.state, **values, "at": at}  # type: ignore[typeddict-item]
         self.dirty = True
+
+    def recall_display(self, remembered: CobotStateData | None) -> None:
+        """Takes the display text and its time from the state a monitor reported last (this one
+        before a restart), so the text the cell still shows is not news."""
+        if remembered is not None and remembered.get("display"):
+            self.state = {
+                **self.state,
+                "display": remembered["display"],
+                "display_at": remembered.get("display_at") or remembered["at"],
+            }
 
 
 class _Handler:
@@ -124,8 +139,11 @@ class Monitor:
             ):  # fmt: skip
                 self.tasks.pop(cobot_id).cancel()
                 self.watched.pop(cobot_id)
+        added = [cobot_id for cobot_id in current if cobot_id not in self.tasks]
+        remembered = await sync_to_async(cobot_states.recall)(added) if added else {}
         for cobot_id, row in current.items():
             if cobot_id not in self.tasks:
+                row.recall_display(remembered.get(cobot_id))
                 self.watched[cobot_id] = row
                 self.tasks[cobot_id] = asyncio.create_task(self._watch_forever(row))
 

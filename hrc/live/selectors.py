@@ -30,8 +30,8 @@ from hrc.live.events import (
     WorkItemData,
 )
 from hrc.live.models import CellStop
-from hrc.organisations.models import Membership, Team
-from hrc.organisations.selectors import AnyUser
+from hrc.organisations.models import Membership, Organisation, Team
+from hrc.organisations.selectors import AnyUser, cells_of
 
 
 @dataclass(frozen=True)
@@ -58,6 +58,15 @@ def access_of(user: AnyUser, organisation_id: int | None) -> Access | None:
     if found is None:
         return None
     return Access(user.pk, user.get_username(), found[0], found[1])
+
+
+def is_cell(organisation_id: int, cell: str) -> bool:
+    """Whether `cell` is one of the organisation's cells; "" (the whole floor) always is."""
+    return not cell or cells_of(organisation_id).filter(name=cell).exists()
+
+
+def organisation_name(organisation_id: int) -> str:
+    return Organisation.objects.filter(pk=organisation_id).values_list("name", flat=True).get()
 
 
 def valid_memberships(pairs: set[tuple[int, int]]) -> set[tuple[int, int]]:

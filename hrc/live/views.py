@@ -36,7 +36,7 @@ from hrc.patterns.selectors import versions_startable_at, why_may_not_start
 @ensure_csrf_cookie
 def tablet(request: HttpRequest, cell: str = "") -> HttpResponse:
     access = _access(request)
-    if cell and not cells_of(access.organisation_id).filter(name=cell).exists():
+    if not selectors.is_cell(access.organisation_id, cell):
         return _unknown_cell(request, access, cell)
     config = {
         "organisation": access.organisation_id,
@@ -59,7 +59,7 @@ def start_cycle(request: HttpRequest, cell: str, version: str) -> HttpResponse:
     """Starts a case of the version from the cell's tablet, as its start rights allow; a refusal
     shows on the tablet at its field and starts nothing."""
     access = _access(request)
-    if not cells_of(access.organisation_id).filter(name=cell).exists():
+    if not selectors.is_cell(access.organisation_id, cell):
         return _unknown_cell(request, access, cell)
     chosen = _startable(request, access, cell).get(int(version))
     if chosen is None:
@@ -109,9 +109,11 @@ def _access(request: HttpRequest) -> Access:
 
 
 def _unknown_cell(request: HttpRequest, access: Access, cell: str) -> HttpResponse:
-    cells = list(cells_of(access.organisation_id))
-    organisation = cells[0].organisation if cells else None
-    context = {"cell": cell, "cells": cells, "organisation": organisation}
+    context = {
+        "cell": cell,
+        "cells": cells_of(access.organisation_id),
+        "organisation": selectors.organisation_name(access.organisation_id),
+    }
     return render(request, "tablet/unknown_cell.html", context, status=404)
 
 

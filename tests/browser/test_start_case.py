@@ -140,7 +140,7 @@ def test_an_operator_starts_a_cycle_at_the_cell_and_a_mistyped_cell_says_so(
     assert (case.reference, case.data["batch"], case.started_by) == ("W-7", 2, operator)
 
     page.goto(f"{live_url}/tablet/cell1/")
-    expect(page.get_by_role("heading", name="There is no cell “cell1”")).to_be_visible()
+    expect(page.get_by_role("heading", name="There is no cell 'cell1'")).to_be_visible()
     expect(page.get_by_role("link", name="cell-a")).to_be_visible()
     expect(page.get_by_role("button", name="STOP every cobot of the cell")).to_have_count(0)
     assert_fits(page)

@@ -15,16 +15,19 @@ from django.contrib.auth.models import User
 from playwright.sync_api import Browser, BrowserContext, Page, ViewportSize, expect
 
 from hrc.cases import services as case_services
-from hrc.cases.choices import CaseStatus, JobState
+from hrc.cases.choices import CaseStatus, EventType, JobState
 from hrc.cases.launcher import RedisProcess, WorkerProcess
 from hrc.cases.models import Case, Job, WorkItem
 from hrc.cobots import urua
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.live import broadcast
-from hrc.organisations.models import Organisation
+from hrc.organisations import services as organisation_services
+from hrc.organisations.choices import Role
+from hrc.organisations.models import Membership, Organisation
 from hrc.patterns.models import PatternVersion
 from tests import factories
+from tests.browser.conftest import assert_fits
 from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.live.server import LiveServer, MonitorProcess
 from tests.polling import until
@@ -33,6 +36,7 @@ pytestmark = pytest.mark.django_db(transaction=True)
 
 Screenshot = Callable[[Page, str], Path]
 PORTRAIT = ViewportSize(width=800, height=1280)
+SMALL = ViewportSize(width=1024, height=768)
 # A change shown within this many milliseconds, with no reload, came over the socket.
 LIVE_MS = 30_000
 
@@ -42,6 +46,7 @@ CHECK_FORM: dict[str, Any] = {
     "properties": {
         "parts": {"type": "integer", "minimum": 1, "title": "Parts in the tray"},
         "clean": {"type": "boolean", "title": "Tray is clean"},
+        "remark": {"type": "string", "title": "Remark"},
     },
 }
 
@@ -190,18 +195,23 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     card.get_by_role("button", name="Complete…").click()
     dialog = page.locator(".form-dialog")
     expect(dialog.get_by_label("Parts in the tray *")).to_be_visible()
-    # A yes/no is two answers, neither taken: nobody answered it yet.
+    # A yes/no is two choices, neither chosen: nothing is answered for the operator.
     clean = dialog.get_by_role("group", name="Tray is clean *")
-    for answer in ("Yes", "No"):
-        expect(clean.get_by_role("radio", name=answer)).not_to_be_checked()
-    dialog.get_by_role("button", name="Complete").click()  # the form is empty: refused
-    expect(dialog.locator(".field-error:visible")).to_have_text(
-        ["Answer this before completing."] * 2
-    )
-    screenshot(page, "tablet-form-unanswered")
-    assert WorkItem.objects.get(case=case, task="to1").result is None  # nothing was sent
+    expect(clean.get_by_role("radio")).to_have_count(2)
+    expect(clean.get_by_label("Yes")).not_to_be_checked()
+    expect(clean.get_by_label("No")).not_to_be_checked()
+    expect(dialog.locator('input[type="checkbox"]')).to_have_count(0)
     dialog.get_by_label("Parts in the tray *").fill("12")
-    clean.get_by_role("radio", name="Yes").check()
+    dialog.get_by_role("button", name="Complete").click()  # "clean" unanswered: refused here
+    expect(dialog.locator('[data-field="clean"] .field-error')).to_have_text(
+        "an answer is required"
+    )
+    expect(dialog.locator('[data-field="parts"] .field-error')).to_be_hidden()
+    screenshot(page, "tablet-form-refused")
+    assert_fits(page)
+    assert WorkItem.objects.get(case=case, task="to1").state == "running"  # nothing was sent
+    clean.get_by_label("No").check()
+    expect(dialog.locator('[data-field="clean"] .field-error')).to_be_hidden()
     screenshot(page, "tablet-form")
     dialog.get_by_role("button", name="Complete").click()
     expect(card).to_have_count(0, timeout=LIVE_MS)
@@ -212,7 +222,7 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     screenshot(page, "tablet-cobot-next-step")
     until(lambda: Case.objects.get(pk=case.pk).status == CaseStatus.COMPLETED, timeout=60)
     item = WorkItem.objects.get(case=case, task="to1")
-    assert item.result == {"parts": 12, "clean": True}
+    assert item.result == {"parts": 12, "clean": False}  # the answers, and no empty remark
     assert item.completed_by == operator
     assert Job.objects.filter(case=case, state=JobState.SUCCEEDED).count() == 2
 
@@ -302,11 +312,15 @@ def test_the_tablet_fits_a_ten_inch_tablet_both_ways(
     expect(page.locator(".connection")).to_have_text("Live")
     expect(page.locator(".cards.mine .card")).to_have_count(1)
     screenshot(page, "tablet-landscape")
+    assert_fits(page)
     for button in page.locator("button:visible").all():
         box = button.bounding_box()
         assert box is not None
         assert box["height"] >= 48, button.inner_text()
         assert box["width"] >= 48, button.inner_text()
+    page.set_viewport_size(SMALL)
+    screenshot(page, "tablet-1024x768")
+    assert_fits(page)
     page.set_viewport_size(PORTRAIT)
     card = page.locator(".cards.mine .card")
     assert card.bounding_box()["width"] > 600  # type: ignore[index]  # one column, full width
@@ -362,3 +376,80 @@ def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_at_which_
     page.goto(f"{server.url}/tablet/")  # the whole floor: every task, nothing elsewhere
     expect(page.locator(".cards.mine .card")).to_have_count(3)
     expect(page.locator(".elsewhere")).to_have_count(0)
+
+
+def test_an_operator_claims_a_team_task_gives_it_back_and_claims_it_again(
+    server: LiveServer,
+    browser: Browser,
+    tablet: BrowserContext,
+    organisation: Organisation,
+    choice_version: PatternVersion,
+    operator: User,
+    screenshot: Screenshot,
+) -> None:
+    team = organisation_services.create_team(organisation, name="Shift A")
+    colleague = factories.make_member(organisation, Role.OPERATOR, "carl-colleague")
+    organisation_services.set_team_members(
+        team, Membership.objects.filter(organisation=organisation, user__in=[operator, colleague])
+    )
+    case = case_services.start_case(
+        choice_version, started_by=None, actor_mapping={"o": {"team": "Shift A"}}
+    )
+    item = WorkItem.objects.get(case=case, task="count")
+    page = tablet.new_page()
+    _sign_in(page, server.url, operator)
+    page.goto(f"{server.url}/tablet/")
+    other = browser.new_context(viewport=SMALL, has_touch=True)
+    theirs = other.new_page()
+    _sign_in(theirs, server.url, colleague)
+    theirs.goto(f"{server.url}/tablet/")
+    offered = f'.cards.team .card[data-item="{item.pk}"]'
+    expect(theirs.locator(offered)).to_be_visible()
+
+    page.locator(offered).get_by_role("button", name="Claim").click()
+    mine = page.locator(f'.cards.mine .card[data-item="{item.pk}"]')
+    expect(mine).to_have_attribute("data-state", "claimed")
+    expect(theirs.locator(offered)).to_have_count(0)  # live: the colleague's tablet drops it
+    screenshot(page, "tablet-claimed-give-back")
+    assert_fits(page)
+
+    mine.get_by_role("button", name="Give back").click()
+    expect(mine).to_have_count(0)
+    expect(page.locator(offered)).to_be_visible()
+    expect(theirs.locator(offered)).to_be_visible()  # offered to the team again, everywhere
+    item.refresh_from_db()
+    assert (item.state, item.claimed_by) == ("offered", None)
+    given_back = case.events.filter(type=EventType.TASK_UNCLAIMED).get()
+    assert given_back.user == operator
+
+    page.locator(offered).get_by_role("button", name="Claim").click()
+    expect(mine).to_have_attribute("data-state", "claimed")
+    mine.get_by_role("button", name="Start").click()
+    expect(mine).to_have_attribute("data-state", "running")
+    expect(mine.get_by_role("button", name="Give back")).to_have_count(0)  # started: it stays
+    other.close()
+
+
+def test_an_unknown_cells_tablet_says_so_and_links_the_cells_there_are(
+    server: LiveServer, tablet: BrowserContext, organisation: Organisation, operator: User,
+    screenshot: Screenshot,
+) -> None:  # fmt: skip
+    organisation_services.ensure_cell(organisation, "weld")
+    organisation_services.ensure_cell(organisation, "paint")
+    page = tablet.new_page()
+    _sign_in(page, server.url, operator)
+    response = page.goto(f"{server.url}/tablet/cell1/")
+    assert response is not None
+    assert response.status == 404
+    expect(page.get_by_role("heading", level=1)).to_have_text(
+        f"There is no cell 'cell1' in {organisation.name}"
+    )
+    expect(page.get_by_role("button", name=re.compile("STOP"))).to_have_count(0)
+    screenshot(page, "tablet-unknown-cell")
+    assert_fits(page)
+    page.set_viewport_size(SMALL)
+    screenshot(page, "tablet-unknown-cell-1024x768")
+    assert_fits(page)
+    page.locator(".cell-links").get_by_role("link", name="weld").click()
+    page.wait_for_url(f"{server.url}/tablet/weld/")
+    expect(page.locator(".connection")).to_have_text("Live")

@@ -150,7 +150,7 @@ def test_another_organisations_cobot_or_a_deactivated_person_starts_nothing(
             started_by=engineer,
             actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
         )
-    assert refused.value.field == "actor_mapping.o"
+    assert list(refused.value.fields) == ["actor_mapping.o"]
     assert not Case.objects.exists()
 
 
@@ -162,7 +162,7 @@ def test_data_of_the_wrong_type_is_refused_by_the_service_at_its_key(
         services.start_cases(
             version, started_by=engineer, actor_mapping=mapping, data={"urgent": "yes"}
         )
-    assert refused.value.field == "data.urgent"
+    assert list(refused.value.fields) == ["data.urgent"]
     assert "urgent must be yes or no" in str(refused.value)
     assert not Case.objects.exists()
 

@@ -21,6 +21,7 @@ from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot
 from hrc.live.consumers import STATE_INTERVAL
 from hrc.live.models import CellStop
+from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cobots.simulator import PROGRAM
@@ -110,6 +111,7 @@ def _move_back_and_forth(driver: SyncDriver) -> None:
 def test_a_tablet_of_another_cell_gets_no_state_of_this_one(
     server: LiveServer, monitor: MonitorProcess, cobot: Cobot, operator: User
 ) -> None:
+    organisation_services.ensure_cell(cobot.organisation, "B")
     cookie = session_cookie(operator)
 
     async def scenario() -> None:
@@ -199,6 +201,27 @@ def test_an_outsider_cannot_stop_our_cell(
 
     assert refused.status_code == 400
     assert "not a member" in refused.json()["detail"]
+    assert not CellStop.objects.exists()
+    cobot.refresh_from_db()
+    assert cobot.stopped_at is None
+
+
+@pytest.mark.parametrize("action", ["stop", "resume"])
+def test_a_cell_the_organisation_does_not_have_cannot_be_stopped_or_resumed(
+    organisation: Organisation, other_organisation: Organisation, operator: User, action: str
+) -> None:
+    cobot = factories.make_cobot(organisation, cell="A")
+    organisation_services.ensure_cell(other_organisation, "cell1")
+    client = APIClient()
+    client.force_authenticate(operator)
+
+    refused = client.post(
+        f"/api/cells/{action}/", {"cell": "cell1", "confirm": True}, format="json"
+    )
+
+    assert refused.status_code == 400
+    message = f"There is no cell 'cell1' in {organisation.name}."
+    assert refused.json() == {"detail": message, "fields": {"cell": [message]}}
     assert not CellStop.objects.exists()
     cobot.refresh_from_db()
     assert cobot.stopped_at is None

@@ -10,6 +10,7 @@ from hrc.cases import services as case_services
 from hrc.cases.models import Case, WorkItem
 from hrc.live import broadcast
 from hrc.live.consumers import RECHECK_SECONDS
+from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Membership, Organisation
 from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.server import LiveServer, session_cookie
@@ -70,6 +71,28 @@ def test_a_bad_cell_name_is_refused_with_a_reason(server: LiveServer, operator: 
         refused = await receive(socket)
         assert refused["type"] == "refused"
         assert "'a b' is not a cell name" in refused["reason"]
+
+    run(scenario())
+
+
+def test_a_cell_the_organisation_does_not_have_is_refused_with_a_reason(
+    server: LiveServer, operator: User, organisation: Organisation, other_organisation: Organisation
+) -> None:
+    """Not a live tablet of nothing: a cell of another organisation is no cell here either."""
+    organisation_services.ensure_cell(other_organisation, "cell1")
+    cookie = session_cookie(operator)
+
+    async def scenario() -> None:
+        socket = await open_socket(server, cookie, "?cell=cell1")
+        refused = await receive(socket)
+        assert refused == {
+            "type": "refused",
+            "reason": "There is no cell 'cell1' in this organisation.",
+        }
+        with pytest.raises(ConnectionClosed) as closed:
+            await receive(socket)
+        assert closed.value.rcvd is not None
+        assert closed.value.rcvd.code == 4404
 
     run(scenario())
 
@@ -170,8 +193,9 @@ def test_a_member_who_leaves_the_organisation_is_cut_off(
 
 
 def test_a_cell_tablet_gets_the_case_deltas_too(
-    server: LiveServer, operator: User, choice_case: Case
+    server: LiveServer, operator: User, choice_case: Case, organisation: Organisation
 ) -> None:
+    organisation_services.ensure_cell(organisation, "A")
     cookie = session_cookie(operator)
     [count] = WorkItem.objects.filter(case=choice_case)
 

@@ -1,7 +1,6 @@
-"""The tablet page over HTTP: a cell that does not exist, and starting a cycle at a cell.
+"""The tablet page: a cell the organisation has, one it does not, and starting a cycle at a cell."""
 
-The browser tests (tests/browser/test_tablet.py) do what the script does.
-"""
+from __future__ import annotations
 
 import pytest
 from django.contrib.auth.models import User
@@ -10,6 +9,7 @@ from django.test import Client
 from hrc.cases import services as case_services
 from hrc.cases.models import Case
 from hrc.cobots.models import Cobot
+from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
 from hrc.organisations.services import ensure_cell
 from hrc.patterns.models import PatternVersion
@@ -23,6 +23,45 @@ def _client(user: User) -> Client:
     client = Client()
     client.force_login(user)
     return client
+
+
+def test_a_cells_tablet_loads_the_live_page(organisation: Organisation, operator: User) -> None:
+    factories.make_cobot(organisation, cell="weld")
+    response = _client(operator).get("/tablet/weld/")
+    assert response.status_code == 200
+    assert b'aria-label="STOP every cobot of the cell"' in response.content
+
+
+def test_an_unknown_cell_says_so_and_lists_the_organisations_cells_with_no_stop(
+    organisation: Organisation, other_organisation: Organisation, operator: User
+) -> None:
+    organisation_services.ensure_cell(organisation, "weld")
+    organisation_services.ensure_cell(organisation, "paint")
+    organisation_services.ensure_cell(other_organisation, "cell1")  # theirs, not ours
+
+    response = _client(operator).get("/tablet/cell1/")
+
+    assert response.status_code == 404
+    page = response.content.decode()
+    assert f"There is no cell 'cell1' in {organisation.name}" in page
+    assert [cell.name for cell in response.context["cells"]] == ["paint", "weld"]
+    assert 'href="/tablet/paint/"' in page
+    assert 'href="/tablet/weld/"' in page
+    assert "STOP" not in page
+    assert "tablet.js" not in page  # no socket, nothing that looks live
+
+
+def test_an_outsiders_cells_are_not_listed_to_them_nor_ours_to_them(
+    organisation: Organisation, outsider: User
+) -> None:
+    organisation_services.ensure_cell(organisation, "weld")
+    response = _client(outsider).get("/tablet/weld/")
+    assert response.status_code == 404
+    assert "weld" not in [cell.name for cell in response.context["cells"]]
+    assert 'href="/tablet/weld/"' not in response.content.decode()
+
+
+# Starting a cycle at a cell -------------------------------------------------------------
 
 
 @pytest.fixture
@@ -39,27 +78,6 @@ def version(
     ensure_cell(organisation, "cell-a")
     ensure_cell(organisation, "cell-b")
     return set_start_rights(version, roles=["engineer", "operator"], cells=["cell-a"])
-
-
-def test_an_unknown_cell_says_so_and_lists_the_cells_without_a_stop(
-    operator: User, organisation: Organisation
-) -> None:
-    ensure_cell(organisation, "cell-a")
-    response = _client(operator).get("/tablet/cell1/")
-    assert response.status_code == 404
-    html = response.content.decode()
-    assert "There is no cell “cell1” in" in html
-    assert 'href="/tablet/cell-a/"' in html
-    assert 'class="stop"' not in html
-
-
-def test_a_cell_of_another_organisation_is_unknown_here(
-    operator: User, other_organisation: Organisation
-) -> None:
-    ensure_cell(other_organisation, "their-cell")
-    response = _client(operator).get("/tablet/their-cell/")
-    assert response.status_code == 404
-    assert "their-cell" not in response.content.decode().split("</h1>", 1)[1]
 
 
 def test_the_start_cell_offers_the_version_and_the_operator_starts_a_cycle(

@@ -70,6 +70,7 @@ export interface CobotStateData {
   program: string;
   joints: number[];
   display: string;
+  display_at: number;
   error: string;
 }
 

@@ -4,6 +4,8 @@ export class ApiError extends Error {
   constructor(
     message: string,
     readonly status: number,
+    /** The messages by field of a refused form (`fields` of a 400), when the server gave them. */
+    readonly fields: Record<string, string[] | string> = {},
   ) {
     super(message);
   }
@@ -25,9 +27,9 @@ export async function request<T>(method: string, url: string, body?: unknown): P
     },
     body: body === undefined ? undefined : JSON.stringify(body),
   });
-  const data = (await response.json().catch(() => ({}))) as { detail?: string };
+  const data = (await response.json().catch(() => ({}))) as { detail?: string; fields?: Record<string, string[] | string> };
   if (!response.ok) {
-    throw new ApiError(data.detail ?? `The server answered ${response.status}.`, response.status);
+    throw new ApiError(data.detail ?? `The server answered ${response.status}.`, response.status, data.fields ?? {});
   }
   return data as T;
 }

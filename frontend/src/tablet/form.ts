@@ -1,10 +1,10 @@
 // A task's form, built from its JSON Schema (the `form` of /api/work-items/<id>/): big touch
-// fields for yes/no, numbers, choices and text; values read back typed.
+// fields for booleans, numbers, choices and text; values read back typed.
 //
-// Only answers are recorded: a yes/no is two choices with neither taken (unless the schema
-// gives a default), a choice starts at "Choose…", and a field left alone is left out of the
-// result rather than sent as false, "" or 0. A required field left unanswered is named at the
-// field before anything is sent (the server refuses it too).
+// It records only answers. A yes/no is two choices, a choice starts at "Choose…", and a field the
+// operator leaves alone is left out of the values (not false, "" or 0). A `default` is shown
+// filled in only on an optional field, where leaving it is an answer the operator can see; a
+// required field is never filled in for them, default or not, so one tap cannot answer it.
 
 export interface FieldSchema {
   type?: string;
@@ -23,74 +23,170 @@ export interface FormSchema {
   required?: string[];
 }
 
-export interface RenderedForm {
-  /** The answers given, typed; unanswered fields are absent. */
-  read(): Record<string, unknown>;
-  /** Marks each required field left unanswered at the field; true when there is none. */
+/** The fields of a rendered form. */
+export interface FormFields {
+  /** The answers given, by field: a field left alone is absent. */
+  values(): Record<string, unknown>;
+  /** Shows "an answer is required" at each required field left alone; true when none is. */
   check(): boolean;
+  /** Shows each message at its field (the server's `fields`), clearing the others; returns the
+   * messages of names that are no field of the form, for the form's own error line. */
+  showErrors(errors: Record<string, string[] | string>): string[];
 }
+
+export const REQUIRED_MESSAGE = "an answer is required";
 
 interface Field {
-  name: string;
+  row: HTMLElement;
+  error: HTMLElement;
   required: boolean;
   read: () => unknown;
-  problem: HTMLElement;
 }
 
-const UNANSWERED = "Answer this before completing.";
-
 /** The form's fields inside `container`. */
-export function renderForm(container: HTMLElement, schema: FormSchema | null): RenderedForm {
+export function buildForm(container: HTMLElement, schema: FormSchema | null): FormFields {
   container.replaceChildren();
+  const properties = schema?.properties ?? {};
   const required = new Set(schema?.required ?? []);
-  const fields: Field[] = [];
-  for (const [name, field] of Object.entries(schema?.properties ?? {})) {
-    const id = `field-${name}`;
+  const fields = new Map<string, Field>();
+  for (const [name, field] of Object.entries(properties)) {
+    const isRequired = required.has(name);
+    const prefill = isRequired ? undefined : field.default;
     const row = document.createElement("div");
     row.className = "field";
-    const title = (field.title ?? name) + (required.has(name) ? " *" : "");
+    row.dataset.field = name;
+    const title = (field.title ?? name) + (isRequired ? " *" : "");
+    const error = document.createElement("p");
+    error.className = "field-error";
+    error.id = `field-${name}-error`;
+    error.hidden = true;
     let read: () => unknown;
-    if (field.enum) {
-      row.append(labelFor(id, title));
-      read = choice(row, id, name, field);
-    } else if (field.type === "boolean") {
-      read = yesNo(row, id, name, title, field);
-    } else {
-      row.append(labelFor(id, title));
-      read = entry(row, id, name, field, required.has(name));
-    }
+    if (field.enum) read = choice(row, name, title, field.enum, prefill, isRequired);
+    else if (field.type === "boolean") read = yesNo(row, name, title, prefill, isRequired);
+    else read = input(row, name, title, field, prefill, isRequired);
+    row.append(error);
     if (field.description) {
       const help = document.createElement("small");
       help.textContent = field.description;
       row.append(help);
     }
-    const problem = document.createElement("p");
-    problem.className = "errors field-error";
-    problem.setAttribute("role", "alert");
-    problem.hidden = true;
-    row.append(problem);
+    for (const control of row.querySelectorAll("input, select")) control.setAttribute("aria-describedby", error.id);
+    // An answer clears the field's message.
+    row.addEventListener("change", () => setError(row, error, ""));
+    row.addEventListener("input", () => setError(row, error, ""));
     container.append(row);
-    fields.push({ name, required: required.has(name), read, problem });
+    fields.set(name, { row, error, required: isRequired, read });
   }
   return {
-    read() {
+    values() {
       const values: Record<string, unknown> = {};
-      for (const field of fields) {
+      for (const [name, field] of fields) {
         const value = field.read();
-        if (value !== undefined) values[field.name] = value;
+        if (value !== undefined) values[name] = value;
       }
       return values;
     },
     check() {
-      let answered = true;
-      for (const field of fields) {
+      let complete = true;
+      for (const field of fields.values()) {
         const missing = field.required && field.read() === undefined;
-        field.problem.textContent = missing ? UNANSWERED : "";
-        field.problem.hidden = !missing;
-        answered &&= !missing;
+        setError(field.row, field.error, missing ? REQUIRED_MESSAGE : "");
+        complete &&= !missing;
       }
-      return answered;
+      if (!complete) focusFirstError(container);
+      return complete;
     },
+    showErrors(errors) {
+      const rest: string[] = [];
+      for (const [name, field] of fields) setError(field.row, field.error, messages(errors[name]).join(" "));
+      for (const [name, message] of Object.entries(errors)) {
+        if (!fields.has(name)) rest.push(`${name}: ${messages(message).join(" ")}`);
+      }
+      focusFirstError(container);
+      return rest;
+    },
+  };
+}
+
+/** The form's fields inside `container`; returns a function that reads the answers given. */
+export function renderForm(container: HTMLElement, schema: FormSchema | null): () => Record<string, unknown> {
+  const form = buildForm(container, schema);
+  return () => form.values();
+}
+
+function choice(row: HTMLElement, name: string, title: string, values: unknown[], prefill: unknown, required: boolean): () => unknown {
+  const id = `field-${name}`;
+  row.append(labelFor(id, title));
+  const select = document.createElement("select");
+  select.id = id;
+  select.name = name;
+  select.required = required;
+  const none = document.createElement("option");
+  none.value = "";
+  none.textContent = "Choose…";
+  select.append(none);
+  for (const value of values) {
+    const option = document.createElement("option");
+    option.value = JSON.stringify(value);
+    option.textContent = String(value);
+    select.append(option);
+  }
+  select.value = prefill !== undefined && values.some((v) => JSON.stringify(v) === JSON.stringify(prefill)) ? JSON.stringify(prefill) : "";
+  row.append(select);
+  return () => (select.value === "" ? undefined : JSON.parse(select.value));
+}
+
+/** Two choices, Yes and No, as radio buttons: neither is chosen until the operator chooses. */
+function yesNo(row: HTMLElement, name: string, title: string, prefill: unknown, required: boolean): () => unknown {
+  row.classList.add("yes-no");
+  const group = document.createElement("fieldset");
+  const legend = document.createElement("legend");
+  legend.textContent = title;
+  group.append(legend);
+  const choices = document.createElement("div");
+  choices.className = "choices";
+  const radios: HTMLInputElement[] = [];
+  for (const [text, value] of [["Yes", true], ["No", false]] as const) {
+    const label = document.createElement("label");
+    label.className = "choice";
+    const radio = document.createElement("input");
+    radio.type = "radio";
+    radio.name = `field-${name}`;
+    radio.value = String(value);
+    radio.required = required;
+    radio.checked = prefill === value;
+    label.append(radio, document.createTextNode(text));
+    choices.append(label);
+    radios.push(radio);
+  }
+  group.append(choices);
+  row.append(group);
+  return () => {
+    const chosen = radios.find((radio) => radio.checked);
+    return chosen ? chosen.value === "true" : undefined;
+  };
+}
+
+function input(row: HTMLElement, name: string, title: string, field: FieldSchema, prefill: unknown, required: boolean): () => unknown {
+  const id = `field-${name}`;
+  row.append(labelFor(id, title));
+  const control = document.createElement("input");
+  control.id = id;
+  control.name = name;
+  const numeric = field.type === "integer" || field.type === "number";
+  control.type = numeric ? "number" : "text";
+  if (numeric) {
+    control.inputMode = field.type === "integer" ? "numeric" : "decimal";
+    control.step = field.type === "integer" ? "1" : "any";
+    if (field.minimum !== undefined) control.min = String(field.minimum);
+    if (field.maximum !== undefined) control.max = String(field.maximum);
+  }
+  if (prefill !== undefined) control.value = String(prefill);
+  control.required = required;
+  row.append(control);
+  return () => {
+    if (control.value === "") return undefined;
+    return numeric ? Number(control.value) : control.value;
   };
 }
 
@@ -101,70 +197,21 @@ function labelFor(id: string, text: string): HTMLLabelElement {
   return label;
 }
 
-/** A drop-down of the schema's values, starting at "Choose…" unless the schema gives a default. */
-function choice(row: HTMLElement, id: string, name: string, field: FieldSchema): () => unknown {
-  const select = document.createElement("select");
-  select.id = id;
-  select.name = name;
-  const none = document.createElement("option");
-  none.value = "";
-  none.textContent = "Choose…";
-  select.append(none);
-  for (const value of field.enum ?? []) {
-    const option = document.createElement("option");
-    option.value = JSON.stringify(value);
-    option.textContent = String(value);
-    select.append(option);
+function setError(row: HTMLElement, error: HTMLElement, message: string): void {
+  error.textContent = message;
+  error.hidden = !message;
+  row.classList.toggle("invalid", !!message);
+  for (const control of row.querySelectorAll("input, select")) {
+    if (message) control.setAttribute("aria-invalid", "true");
+    else control.removeAttribute("aria-invalid");
   }
-  select.value = field.default !== undefined ? JSON.stringify(field.default) : "";
-  row.append(select);
-  return () => (select.value === "" ? undefined : JSON.parse(select.value));
 }
 
-/** Yes and No as two big buttons of one group; neither is taken unless the schema's default says. */
-function yesNo(row: HTMLElement, id: string, name: string, title: string, field: FieldSchema): () => unknown {
-  row.classList.add("yes-no");
-  const group = document.createElement("fieldset");
-  group.id = id;
-  const legend = document.createElement("legend");
-  legend.textContent = title;
-  group.append(legend);
-  const boxes: HTMLInputElement[] = [];
-  for (const [answer, text] of [[true, "Yes"], [false, "No"]] as const) {
-    const label = document.createElement("label");
-    const box = document.createElement("input");
-    box.type = "radio";
-    box.name = name;
-    box.value = String(answer);
-    box.checked = field.default === answer;
-    label.append(box, document.createTextNode(text));
-    group.append(label);
-    boxes.push(box);
-  }
-  row.append(group);
-  return () => {
-    const taken = boxes.find((box) => box.checked);
-    return taken === undefined ? undefined : taken.value === "true";
-  };
+function focusFirstError(container: HTMLElement): void {
+  container.querySelector<HTMLElement>(".field.invalid input, .field.invalid select")?.focus();
 }
 
-function entry(row: HTMLElement, id: string, name: string, field: FieldSchema, required: boolean): () => unknown {
-  const input = document.createElement("input");
-  input.id = id;
-  input.name = name;
-  const numeric = field.type === "integer" || field.type === "number";
-  input.type = numeric ? "number" : "text";
-  if (numeric) {
-    input.inputMode = field.type === "integer" ? "numeric" : "decimal";
-    input.step = field.type === "integer" ? "1" : "any";
-    if (field.minimum !== undefined) input.min = String(field.minimum);
-    if (field.maximum !== undefined) input.max = String(field.maximum);
-  }
-  if (field.default !== undefined) input.value = String(field.default);
-  input.required = required;
-  row.append(input);
-  return () => {
-    if (input.value.trim() === "") return undefined;
-    return numeric ? Number(input.value) : input.value;
-  };
+function messages(value: string[] | string | undefined): string[] {
+  if (value === undefined) return [];
+  return Array.isArray(value) ? value.map(String) : [String(value)];
 }

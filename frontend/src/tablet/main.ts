@@ -5,13 +5,14 @@ import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
 import { ApiError, request } from "./api";
-import { type FormSchema, renderForm } from "./form";
+import { buildForm, type FormSchema } from "./form";
 import {
   activity,
   atThisCell,
   cellsOf,
   cellWords,
-  cobotsOf,
+  cobotWork,
+  type DisplayMessage,
   degrees,
   elsewhere,
   humanSafety,
@@ -19,6 +20,7 @@ import {
   myTasks,
   nextAction,
   teamTasks,
+  withDisplayMessages,
 } from "./view";
 
 interface Config {
@@ -47,8 +49,7 @@ const socket = new LiveSocket({
   store,
   onStatus: showStatus,
 });
-const messages: Array<{ cobot: string; text: string; at: number }> = [];
-const lastDisplay = new Map<number, string>();
+let messages: DisplayMessage[] = [];
 let frame = 0;
 
 store.subscribe((event: LiveEvent) => {
@@ -107,32 +108,30 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     article.append(element("p", "away", `At ${where}: go there to do it.`));
   }
   if (item.instructions) article.append(element("p", "instructions", item.instructions));
-  const cobots = cobotsOf(state, item);
-  if (cobots.length) {
+  const work = cobotWork(state, item);
+  if (work.length) {
     const list = element("ul", "with-cobots");
-    for (const cobot of cobots) {
-      list.append(element("li", "", `${cobot.name}: ${activity(cobot)}`));
-    }
+    list.append(...work.map((line) => element("li", "", line)));
     article.append(list);
   }
+  const actions = element("div", "card-actions");
   const action = nextAction(state, item);
-  if (action) {
-    const button = element("button", `action ${action === "complete" ? "primary" : ""}`, label(action));
-    button.dataset.action = action;
-    button.dataset.item = String(item.id);
-    article.append(button);
-  }
-  if (mayGiveBack(state, item)) {
-    const back = element("button", "action give-back", "Give back");
-    back.dataset.action = "unclaim";
-    back.dataset.item = String(item.id);
-    article.append(back);
-  }
+  if (action) actions.append(actionButton(item, action, `action ${action === "complete" ? "primary" : ""}`));
+  if (mayGiveBack(state, item)) actions.append(actionButton(item, "unclaim", "give-back"));
+  if (actions.childElementCount) article.append(actions);
   return article;
 }
 
+function actionButton(item: WorkItemData, action: string, className: string): HTMLButtonElement {
+  const button = element("button", className, label(action));
+  button.type = "button";
+  button.dataset.action = action;
+  button.dataset.item = String(item.id);
+  return button;
+}
+
 function label(action: string): string {
-  return { claim: "Claim", start: "Start", complete: "Complete…" }[action] ?? action;
+  return { claim: "Claim", start: "Start", complete: "Complete…", unclaim: "Give back" }[action] ?? action;
 }
 
 function renderCobots(state: LiveState): void {
@@ -200,15 +199,7 @@ function renderStop(state: LiveState): void {
 
 function collectMessages(): void {
   const state = store.state;
-  if (!state) return;
-  for (const cobot of state.cobots.values()) {
-    const text = cobot.state?.display ?? "";
-    if (text && lastDisplay.get(cobot.id) !== text) {
-      messages.unshift({ cobot: cobot.name, text, at: cobot.state!.at });
-      messages.length = Math.min(messages.length, MAX_MESSAGES);
-    }
-    lastDisplay.set(cobot.id, text);
-  }
+  if (state) messages = withDisplayMessages(messages, state.cobots.values(), MAX_MESSAGES);
 }
 
 function renderMessages(): void {
@@ -222,7 +213,7 @@ function renderMessages(): void {
       const item = element("li", "message");
       item.append(
         element("time", "", new Date(message.at * 1000).toLocaleTimeString()),
-        element("strong", "", message.cobot),
+        element("strong", "", message.name),
         element("span", "text", message.text),
       );
       return item;
@@ -267,7 +258,7 @@ async function openForm(id: number): Promise<void> {
   form.method = "dialog";
   form.noValidate = true; // the server checks the form and names each field it refuses
   const fields = element("div", "fields");
-  const rendered = renderForm(fields, detail.form);
+  const answers = buildForm(fields, detail.form);
   const error = element("p", "errors");
   error.setAttribute("role", "alert");
   const cancel = element("button", "", "Cancel");
@@ -280,16 +271,23 @@ async function openForm(id: number): Promise<void> {
   form.append(element("h2", "", detail.label), element("p", "instructions", detail.instructions), fields, error, actions);
   form.addEventListener("submit", async (event) => {
     event.preventDefault();
-    if (!rendered.check()) {
-      error.textContent = "Some answers are missing: see the fields marked.";
+    error.textContent = "";
+    // Required answers are asked for here, at their fields; the server refuses them too.
+    if (!answers.check()) {
+      error.textContent = "Answer the questions marked above.";
       return;
     }
     submit.disabled = true;
     try {
-      await request("POST", `/api/work-items/${id}/complete/`, { data: rendered.read() });
+      await request("POST", `/api/work-items/${id}/complete/`, { data: answers.values() });
       dialog.close();
     } catch (failure) {
-      error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+      if (failure instanceof ApiError && Object.keys(failure.fields).length) {
+        const rest = answers.showErrors(failure.fields);
+        error.textContent = rest.length ? rest.join(" ") : "Correct the answers marked above.";
+      } else {
+        error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+      }
     } finally {
       submit.disabled = false;
     }

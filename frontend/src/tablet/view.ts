@@ -86,22 +86,42 @@ export function cobotsOf(state: LiveState, item: WorkItemData): CobotData[] {
   return ids.map((id) => state.cobots.get(id)).filter((c): c is CobotData => c !== undefined);
 }
 
+/** One line per cobot of the task's case: what it is doing for this case. Its work for another
+ * case is not this task's, so the card says only that the cobot is busy with another case. */
+export function cobotWork(state: LiveState, item: WorkItemData): string[] {
+  return cobotsOf(state, item).map((cobot) => `${cobot.name}: ${workFor(cobot, item.case)}`);
+}
+
+function workFor(cobot: CobotData, caseId: number): string {
+  const current = cobot.queue.current;
+  if (!current || current.case === caseId) return activity(cobot);
+  // A STOP, a fault or a lost connection is the cell's news, whichever case the cobot serves.
+  return trouble(cobot) ?? "busy with another case";
+}
+
 /** One line: what the cobot is doing right now, or waiting for. */
 export function activity(cobot: CobotData): string {
+  const problem = trouble(cobot);
+  if (problem) return problem;
+  const current = cobot.queue.current;
+  if (current) {
+    const step = current.step !== null ? ` (step ${current.step})` : "";
+    const paused = cobot.state?.program_state === "Paused" ? ", paused" : "";
+    return `${current.label || current.task}${step}, case ${current.case}${paused}`;
+  }
+  if (cobot.queue.waiting_for) return `waiting: ${cobot.queue.waiting_for}`;
+  return cobot.queue.queue_length ? `${cobot.queue.queue_length} queued` : "idle";
+}
+
+/** What keeps the cobot from working, whatever it works on; null when nothing does. */
+function trouble(cobot: CobotData): string | null {
   const state = cobot.state;
   if (cobot.stopped) return "held by STOP";
   if (state && !state.reachable) return `unreachable${state.error ? `: ${state.error}` : ""}`;
   if (state && !["SAFETY_MODE_NORMAL", "SAFETY_MODE_REDUCED"].includes(state.safety_mode)) {
     return `${humanSafety(state.safety_mode)}: clear it at the robot`;
   }
-  const current = cobot.queue.current;
-  if (current) {
-    const step = current.step !== null ? ` (step ${current.step})` : "";
-    const paused = state?.program_state === "Paused" ? ", paused" : "";
-    return `${current.label || current.task}${step}, case ${current.case}${paused}`;
-  }
-  if (cobot.queue.waiting_for) return `waiting: ${cobot.queue.waiting_for}`;
-  return cobot.queue.queue_length ? `${cobot.queue.queue_length} queued` : "idle";
+  return null;
 }
 
 export function humanSafety(mode: string): string {
@@ -117,9 +137,33 @@ export function nextAction(state: LiveState, item: WorkItemData): "claim" | "sta
   return null;
 }
 
-/** A task the operator claimed and has not started can be given back to the others who may do it. */
+/** Whether the user may give the task back to its team or candidates: they claimed it and have
+ * not started it. A started task stays with whoever started it (an engineer can reassign it). */
 export function mayGiveBack(state: LiveState, item: WorkItemData): boolean {
   return item.state === "claimed" && item.claimed_by === state.user.id;
+}
+
+/** A text a cobot's display showed, at the time it appeared there. */
+export interface DisplayMessage {
+  cobot: number;
+  name: string;
+  text: string;
+  at: number; // seconds since the epoch
+}
+
+/** `messages` with the texts the cobots' displays show now, newest first, at most `max`. A text
+ * is one message however often it is sent again (each state, each snapshot after a reconnect or
+ * a resync): it is known by its cobot and the time it appeared, and keeps that time. */
+export function withDisplayMessages(messages: DisplayMessage[], cobots: Iterable<CobotData>, max: number): DisplayMessage[] {
+  const known = new Set(messages.map((message) => `${message.cobot}@${message.at}`));
+  const added: DisplayMessage[] = [];
+  for (const cobot of cobots) {
+    const state = cobot.state;
+    if (!state?.display || known.has(`${cobot.id}@${state.display_at}`)) continue;
+    added.push({ cobot: cobot.id, name: cobot.name, text: state.display, at: state.display_at });
+  }
+  if (!added.length) return messages;
+  return [...added, ...messages].sort((a, b) => b.at - a.at).slice(0, max);
 }
 
 /** Joint angles in degrees, for the panel. */

@@ -82,7 +82,7 @@ describe("cobots and the cell", () => {
     const store = loaded();
     const state = {
       cobot: 5, at: 20, reachable: true, robot_mode: "Running", safety_mode: "SAFETY_MODE_NORMAL",
-      program_state: "Playing", program: "p", joints: [0, 0, 0, 0, 0, 0], display: "", error: "",
+      program_state: "Playing", program: "p", joints: [0, 0, 0, 0, 0, 0], display: "", display_at: 0, error: "",
     };
     store.apply({ type: "cobot-state", states: [state] });
     expect(store.apply({ type: "cobot-state", states: [{ ...state, at: 10, robot_mode: "Idle" }] })).toBe("ignored");

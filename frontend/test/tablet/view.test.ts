@@ -1,7 +1,7 @@
 import { describe, expect, it } from "vitest";
 import type { Snapshot } from "../../src/live/events";
 import { type LiveState, LiveStore } from "../../src/live/store";
-import { atThisCell, cellsOf, cellWords, elsewhere, mayGiveBack, myTasks, teamTasks } from "../../src/tablet/view";
+import { atThisCell, cellsOf, cellWords, cobotWork, elsewhere, myTasks, teamTasks, withDisplayMessages } from "../../src/tablet/view";
 import { item, snapshot } from "../live/fixtures";
 
 const WELD_ARM = {
@@ -106,12 +106,71 @@ describe("cell words", () => {
   });
 });
 
-describe("giving a task back", () => {
-  it("is offered on a task the operator claimed and has not started, and on no other", () => {
-    const state = floor("");
-    const mine = item({ id: 101, case: 10, state: "claimed", claimed_by: state.user.id });
-    expect(mayGiveBack(state, mine)).toBe(true);
-    expect(mayGiveBack(state, { ...mine, state: "running" })).toBe(false);
-    expect(mayGiveBack(state, { ...mine, claimed_by: state.user.id + 1 })).toBe(false);
+describe("a task card's cobots", () => {
+  const busy = (caseId: number, extra: object = {}) => ({
+    ...WELD_ARM,
+    ...extra,
+    queue: {
+      ...WELD_ARM.queue,
+      queue_length: 1,
+      current: { case: caseId, work_item: 900, task: "tc1", label: "weld the seam", kind: "step", step: 2, attempt: 1 },
+    },
+  });
+  const state = (cobot: object) =>
+    floor("weld", {
+      cases: [
+        { id: 10, seq: 2, status: "running", name: "Weld", cobots: [5] },
+        { id: 14, seq: 2, status: "running", name: "Weld", cobots: [5] },
+      ],
+      work_items: [item({ id: 101, case: 10 })],
+      cobots: [cobot as typeof WELD_ARM],
+    });
+
+  it("list the cobot's work for the task's own case", () => {
+    const here = state(busy(10));
+    expect(cobotWork(here, here.workItems.get(101)!)).toEqual(["weld-arm: weld the seam (step 2), case 10"]);
+  });
+
+  it("do not list the cobot's work for another case", () => {
+    const there = state(busy(14));
+    expect(cobotWork(there, there.workItems.get(101)!)).toEqual(["weld-arm: busy with another case"]);
+  });
+
+  it("still say the cobot is held by a STOP while it serves another case", () => {
+    const stopped = state(busy(14, { stopped: true }));
+    expect(cobotWork(stopped, stopped.workItems.get(101)!)).toEqual(["weld-arm: held by STOP"]);
+  });
+});
+
+describe("display messages", () => {
+  const showing = (display: string, display_at: number, at: number) => ({
+    ...WELD_ARM,
+    state: {
+      cobot: 5, at, reachable: true, robot_mode: "Running", safety_mode: "SAFETY_MODE_NORMAL",
+      program_state: "Playing", program: "p", joints: [], display, display_at, error: "",
+    },
+  });
+
+  it("keep the time a text appeared, however often its state is sent again", () => {
+    let messages = withDisplayMessages([], [showing("Place the part", 100, 100)], 20);
+    messages = withDisplayMessages(messages, [showing("Place the part", 100, 130)], 20); // joints moved
+    expect(messages).toEqual([{ cobot: 5, name: "weld-arm", text: "Place the part", at: 100 }]);
+  });
+
+  it("do not come back as new after the state was lost and a snapshot brings it again", () => {
+    let messages = withDisplayMessages([], [showing("Place the part", 100, 100)], 20);
+    messages = withDisplayMessages(messages, [{ ...WELD_ARM, state: null }], 20); // expired, reconnecting
+    messages = withDisplayMessages(messages, [showing("Place the part", 100, 400)], 20); // the snapshot
+    expect(messages.map((m) => m.at)).toEqual([100]);
+  });
+
+  it("add a new text, newest first, and the same text shown again later as a new message", () => {
+    let messages = withDisplayMessages([], [showing("Place the part", 100, 100)], 20);
+    messages = withDisplayMessages(messages, [showing("Take the part", 150, 150)], 20);
+    messages = withDisplayMessages(messages, [showing("Place the part", 200, 200)], 2);
+    expect(messages.map((m) => [m.text, m.at])).toEqual([
+      ["Place the part", 200],
+      ["Take the part", 150],
+    ]);
   });
 });

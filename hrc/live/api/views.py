@@ -2,7 +2,8 @@
 
 Any member of the organisation may stop its cells and resume them (operators
 above all: they stand at the cell). A non-member is told the organisation is
-not theirs (400), as target_organisation does.
+not theirs (400), as target_organisation does. A cell the organisation does
+not have is refused (400 naming `cell`): nothing is stopped, nothing written.
 """
 
 from typing import Any
@@ -37,7 +38,7 @@ class StopCellView(APIView):
         body = CellRequestSerializer(data=request.data)
         body.is_valid(raise_exception=True)
         organisation = _organisation(request, body.validated_data.get("organisation"))
-        cell = body.validated_data["cell"]
+        cell = _cell(organisation, body.validated_data["cell"])
         before = selectors.active_stop(organisation.pk, cell)
         stop = services.stop_cell(organisation, cell, by=request.user)  # type: ignore[arg-type]
         code = status.HTTP_200_OK if before and before["id"] == stop.pk else status.HTTP_201_CREATED
@@ -52,10 +53,11 @@ class ResumeCellView(APIView):
         body = ResumeRequestSerializer(data=request.data)
         body.is_valid(raise_exception=True)
         organisation = _organisation(request, body.validated_data.get("organisation"))
+        cell = _cell(organisation, body.validated_data["cell"])
         try:
             stop = services.resume_cell(
                 organisation,
-                body.validated_data["cell"],
+                cell,
                 by=request.user,  # type: ignore[arg-type]
                 confirmed=body.validated_data["confirm"],
             )
@@ -70,3 +72,10 @@ def _organisation(request: Request, requested: Any) -> Organisation:
         what = f"organisation {requested}" if requested is not None else "any organisation"
         raise Rejected({"detail": f"You are not a member of {what}."})
     return Organisation.objects.get(pk=access.organisation_id)
+
+
+def _cell(organisation: Organisation, cell: str) -> str:
+    if not selectors.is_cell(organisation.pk, cell):
+        message = f"There is no cell {cell!r} in {organisation.name}."
+        raise Rejected({"detail": message, "fields": {"cell": [message]}})
+    return cell

@@ -178,7 +178,7 @@ def test_unclaim_gives_the_task_back(
 @pytest.mark.parametrize(
     ("data", "named"),
     [
-        ({}, "count: not answered"),
+        ({}, "count: an answer is required"),
         ({"count": 0}, "count: 0 is less than the minimum of 1"),
         ({"count": "many"}, "count: 'many' is not of type 'integer'"),
     ],
@@ -193,6 +193,60 @@ def test_a_completion_the_form_refuses_is_a_400_naming_the_field(
     assert named in response.data["detail"]
     item.refresh_from_db()
     assert item.state == WorkItemState.RUNNING
+
+
+ANSWER_FORM: dict[str, Any] = {
+    "type": "object",
+    "required": ["seated", "quality"],
+    "properties": {
+        "seated": {"type": "boolean", "title": "Part seated?"},
+        "quality": {"title": "Quality", "enum": ["OK", "NOK"]},
+        "note": {"type": "string"},
+        "spare": {"type": "integer", "default": 2},
+    },
+}
+
+
+@pytest.fixture
+def answer_case(organisation: Organisation, engineer: User, operator: User) -> Case:
+    """The choice case, its count task asking a required yes/no and a required choice."""
+    document = factories.choice_document()
+    document["processes"][0]["transitions"][0]["task"]["form"] = ANSWER_FORM
+    version = factories.make_version(organisation, published_by=engineer, draft=document)
+    return factories.make_case(
+        version, started_by=engineer, actor_mapping={"o": {"users": [operator.pk]}}
+    )
+
+
+def test_a_completion_missing_required_answers_is_refused_at_each_field_and_nothing_is_written(
+    operator_client: APIClient, answer_case: Case
+) -> None:
+    item = factories.open_work_item(answer_case, "count")
+    _act(operator_client, item, "start")
+    events = answer_case.events.count()
+    response = _act(operator_client, item, "complete", {"data": {"quality": "OK"}})
+    assert response.status_code == 400
+    assert response.data["fields"] == {"seated": ["an answer is required"]}
+    assert "seated: an answer is required" in response.data["detail"]
+    item.refresh_from_db()
+    assert (item.state, item.result, item.completed_by) == (WorkItemState.RUNNING, None, None)
+    assert answer_case.events.count() == events
+    both = _act(operator_client, item, "complete", {"data": {}})
+    assert set(both.data["fields"]) == {"seated", "quality"}
+
+
+def test_a_completion_stores_exactly_the_answers_given(
+    operator_client: APIClient, answer_case: Case
+) -> None:
+    """No, given, is an answer; the optional fields left out stay out, default or not."""
+    item = factories.open_work_item(answer_case, "count")
+    _act(operator_client, item, "start")
+    response = _act(
+        operator_client, item, "complete", {"data": {"seated": False, "quality": "NOK"}}
+    )
+    assert response.status_code == 200, response.data
+    item.refresh_from_db()
+    assert item.result == {"seated": False, "quality": "NOK"}
 
 
 def test_completion_data_that_is_no_object_is_a_400(
