@@ -807,3 +807,32 @@ def record_event(
         marking_after=dict(after) if after is not None else marking,
         detail=dict(detail or {}),
     )  # fmt: skip
+
+
+def hand_back_work_items(user: User, organisation_id: int, by: User | None) -> int:
+    """Gives every open operator task `user` holds in the organisation back to its candidates
+    (claimed and started alike: they are leaving), each with an event in its case's log.
+    Returns how many went back. Registered with hrc.organisations.hooks for deactivation.
+    """
+    held = WorkItem.objects.filter(
+        case__organisation_id=organisation_id,
+        claimed_by=user,
+        kind=WorkItemKind.OPERATOR,
+        state__in=[WorkItemState.CLAIMED, WorkItemState.RUNNING],
+    ).values_list("pk", "case_id")
+    for item_id, case_id in list(held):
+        with transaction.atomic():
+            case = lock_case(case_id)
+            item = WorkItem.objects.get(pk=item_id)
+            if item.claimed_by_id != user.pk or item.state not in (
+                WorkItemState.CLAIMED, WorkItemState.RUNNING
+            ):
+                continue  # moved on before the lock
+            item.state, item.claimed_by = WorkItemState.OFFERED, None
+            item.save(update_fields=["state", "claimed_by"])
+            record_event(
+                case, EventType.TASK_REASSIGNED, item=item, user=by,
+                detail={"from": user.get_username(), "to": None, "why": "deactivated"},
+            )  # fmt: skip
+            case.save()
+    return len(held)
