@@ -820,6 +820,7 @@ def hand_back_work_items(user: User, organisation_id: int, by: User | None) -> i
         kind=WorkItemKind.OPERATOR,
         state__in=[WorkItemState.CLAIMED, WorkItemState.RUNNING],
     ).values_list("pk", "case_id")
+    handed_back = 0
     for item_id, case_id in list(held):
         with transaction.atomic():
             case = lock_case(case_id)
@@ -835,4 +836,5 @@ def hand_back_work_items(user: User, organisation_id: int, by: User | None) -> i
                 detail={"from": user.get_username(), "to": None, "why": "deactivated"},
             )  # fmt: skip
             case.save()
-    return len(held)
+            handed_back += 1
+    return handed_back
