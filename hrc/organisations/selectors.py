@@ -85,3 +85,12 @@ def teams_of(organisation_id: int) -> QuerySet[Team]:
 def admin_records_of(organisation_id: int) -> QuerySet[AdminRecord]:
     """The organisation's administration record, latest first."""
     return AdminRecord.objects.filter(organisation_id=organisation_id).select_related("actor")
+
+
+def admin_organisations_of(user: AnyUser) -> QuerySet[Organisation]:
+    """The organisations the user is an active admin of."""
+    if not user.is_authenticated:
+        return Organisation.objects.none()
+    return Organisation.objects.filter(
+        memberships__user_id=user.pk, memberships__role=Role.ADMIN, memberships__is_active=True
+    )
