@@ -14,7 +14,7 @@ from django.test import Client
 from hrc.cases import jobs
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot, CobotCommand
-from hrc.organisations.models import Organisation
+from hrc.organisations.models import AdminRecord, Cell, Organisation
 from tests import factories
 from tests.cobots.simulator import PROGRAM
 
@@ -132,8 +132,6 @@ def _cobot_form(**changes: object) -> dict[str, object]:
 def test_an_engineer_registers_a_cobot_in_one_of_the_organisations_cells(
     engineer: User, organisation: Organisation
 ) -> None:
-    from hrc.organisations.models import AdminRecord, Cell
-
     Cell.objects.create(organisation=organisation, name="weld")
     response = _client(engineer).post("/cobots/new/", _cobot_form(cell="weld"))
     assert response.status_code == 302
@@ -145,8 +143,6 @@ def test_an_engineer_registers_a_cobot_in_one_of_the_organisations_cells(
 def test_another_organisations_cell_is_refused_at_the_field(
     engineer: User, other_organisation: Organisation
 ) -> None:
-    from hrc.organisations.models import Cell
-
     Cell.objects.create(organisation=other_organisation, name="theirs")
     response = _client(engineer).post("/cobots/new/", _cobot_form(cell="theirs"))
     assert response.status_code == 400
