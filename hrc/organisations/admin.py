@@ -199,3 +199,12 @@ class TeamAdmin(TeamAdminBase):
     def delete_queryset(self, request: HttpRequest, queryset: QuerySet[Team]) -> None:
         for team in queryset:
             services.delete_team(team)
+
+
+def _superusers_only(request: HttpRequest) -> bool:
+    # The site shows every organisation at once, so it is for the people who run the
+    # installation. An organisation's admins administer it at /organisation/, inside its wall.
+    return bool(request.user.is_active and request.user.is_superuser)
+
+
+admin.site.has_permission = _superusers_only  # type: ignore[method-assign]
