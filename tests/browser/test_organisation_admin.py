@@ -1,0 +1,97 @@
+"""An organisation's admin, who is no superuser, sets up the floor in a real browser:
+adds an operator (who then signs in with the one-time password), a team with the
+operator, a cell and a cobot in that cell. Each page is shot at 1280×800 and
+checked for sideways scrolling and cut-off text."""
+
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from django.contrib.auth.models import User
+from playwright.sync_api import Browser, Page, expect
+
+from hrc.cobots.models import Cobot
+from hrc.organisations.models import Membership, Organisation, Team
+from tests.browser.conftest import assert_fits
+
+pytestmark = pytest.mark.django_db(transaction=True)
+
+SignIn = Callable[[Page, User], None]
+Screenshot = Callable[[Page, str], Path]
+
+
+def _shot(page: Page, screenshot: Screenshot, name: str) -> None:
+    assert_fits(page)
+    screenshot(page, name)
+
+
+def test_an_admin_adds_an_operator_a_team_a_cell_and_a_cobot(
+    page: Page,
+    browser: Browser,
+    live_url: str,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+    admin: User,
+    organisation: Organisation,
+) -> None:
+    assert not admin.is_staff and not admin.is_superuser
+    page.set_viewport_size({"width": 1280, "height": 800})
+    sign_in(page, admin)
+
+    page.goto(f"{live_url}/organisation/people/")
+    form = page.locator("#add-person")
+    form.get_by_label("Username", exact=True).fill("otto")
+    form.get_by_label("Name", exact=True).fill("Otto Operator")
+    form.get_by_label("Role").select_option("operator")
+    form.get_by_role("button", name="Add the person").click()
+    secret = page.locator("#one-time-password code")
+    expect(secret).to_be_visible()
+    password = secret.inner_text().strip()
+    _shot(page, screenshot, "organisation-people")
+
+    operator_page = browser.new_context(viewport={"width": 1280, "height": 800}).new_page()
+    operator_page.goto(f"{live_url}/accounts/login/")
+    operator_page.get_by_label("User name").fill("otto")
+    operator_page.get_by_label("Password").fill(password)
+    operator_page.get_by_role("button", name="Sign in").click()
+    operator_page.wait_for_url(f"{live_url}/")
+    operator_page.context.close()
+
+    page.goto(f"{live_url}/organisation/teams/")
+    form = page.locator("#add-team")
+    form.get_by_label("Name", exact=True).fill("Morning shift")
+    form.get_by_label("otto").check()
+    form.get_by_role("button", name="Create the team").click()
+    expect(page.locator("table.teams")).to_contain_text("otto")
+    _shot(page, screenshot, "organisation-teams")
+
+    page.goto(f"{live_url}/organisation/cells/")
+    form = page.locator("#add-cell")
+    form.get_by_label("Name", exact=True).fill("cell 1")
+    form.get_by_role("button", name="Create the cell").click()
+    expect(page.locator("#id_name-errors")).to_contain_text("not a cell name")
+    page.locator("#add-cell").get_by_label("Name", exact=True).fill("cell1")
+    page.locator("#add-cell").get_by_label("Description").fill("Assembly, by the north door")
+    page.locator("#add-cell").get_by_role("button", name="Create the cell").click()
+    expect(page.get_by_role("link", name="/tablet/cell1/")).to_be_visible()
+    _shot(page, screenshot, "organisation-cells")
+
+    page.goto(f"{live_url}/cobots/")
+    page.get_by_role("link", name="Register a cobot").click()
+    form = page.locator("#cobot-form")
+    form.get_by_label("Name", exact=True).fill("cobot7")
+    form.get_by_label("Endpoint").fill("opc.tcp://127.0.0.1:4899")
+    form.get_by_label("Cell").select_option("cell1")
+    _shot(page, screenshot, "cobot-new")
+    form.get_by_role("button", name="Register the cobot").click()
+    expect(page.get_by_role("heading", name="cobot7")).to_be_visible()
+    page.get_by_role("link", name="Edit").click()
+    expect(page.locator("#cobot-form")).to_be_visible()
+    _shot(page, screenshot, "cobot-edit")
+
+    membership = Membership.objects.get(user__username="otto", organisation=organisation)
+    assert membership.role == "operator"
+    assert list(Team.objects.get(name="Morning shift").members.all()) == [membership]
+    assert Cobot.objects.get(name="cobot7").cell == "cell1"
+    assert re.fullmatch(r"[A-Za-z0-9_-]{16}", password)
