@@ -826,7 +826,8 @@ def hand_back_work_items(user: User, organisation_id: int, by: User | None) -> i
             case = lock_case(case_id)
             item = WorkItem.objects.get(pk=item_id)
             if item.claimed_by_id != user.pk or item.state not in (
-                WorkItemState.CLAIMED, WorkItemState.RUNNING
+                WorkItemState.CLAIMED,
+                WorkItemState.RUNNING,
             ):
                 continue  # moved on before the lock
             item.state, item.claimed_by = WorkItemState.OFFERED, None

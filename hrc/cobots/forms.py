@@ -25,8 +25,8 @@ class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs make
         model = Cobot
         fields = ["name", "driver", "endpoint", "credentials_source", "cell", "is_active"]
 
-    def __init__(self, *args: Any, instance: Cobot, **kwargs: Any) -> None:
-        super().__init__(*args, instance=instance, **kwargs)
+    def __init__(self, data: Any = None, *, instance: Cobot) -> None:
+        super().__init__(data, instance=instance)
         names = list(cells_of(instance.organisation_id).values_list("name", flat=True))
         if instance.cell and instance.cell not in names:
             names.append(instance.cell)

@@ -108,15 +108,14 @@ def cobot_new(request: HttpRequest) -> HttpResponse:
     if membership is None or membership.role not in WRITER_ROLES:
         return _refused(request, 403, ENGINEERS_ONLY)
     form = CobotForm(request.POST or None, instance=Cobot(organisation=membership.organisation))
-    if request.method == "POST":
-        if form.is_valid():
-            try:
-                cobot = services.create_cobot(membership.organisation, **form.cleaned_data)
-            except ValidationError as error:
-                form.add_service_errors(error)
-            else:
-                _record(cobot, request.user, AdminAction.COBOT_REGISTERED, form.cleaned_data)
-                return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
+    if request.method == "POST" and form.is_valid():
+        try:
+            cobot = services.create_cobot(membership.organisation, **form.cleaned_data)
+        except ValidationError as error:
+            form.add_service_errors(error)
+        else:
+            _record(cobot, request.user, AdminAction.COBOT_REGISTERED, form.cleaned_data)
+            return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
     status = 400 if form.errors else 200
     context = {"form": form, "cobot": None, "section": "cobots"}
     return render(request, "cobots/cobot_form.html", context, status=status)
@@ -137,16 +136,15 @@ def cobot_edit(request: HttpRequest, pk: int) -> HttpResponse:
         form = CobotForm(instance=cobot)
     else:
         form = CobotForm(request.POST or None, instance=cobot)
-    if request.method == "POST" and tested is None:
-        if form.is_valid():
-            changes = {f: form.cleaned_data[f] for f in form.changed_data}
-            try:
-                services.update_cobot(cobot, **changes)
-            except ValidationError as error:
-                form.add_service_errors(error)
-            else:
-                _record(cobot, request.user, AdminAction.COBOT_CHANGED, changes)
-                return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
+    if request.method == "POST" and tested is None and form.is_valid():
+        changes = {f: form.cleaned_data[f] for f in form.changed_data}
+        try:
+            services.update_cobot(cobot, **changes)
+        except ValidationError as error:
+            form.add_service_errors(error)
+        else:
+            _record(cobot, request.user, AdminAction.COBOT_CHANGED, changes)
+            return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
     status = 400 if form.errors else 200
     context = {"form": form, "cobot": cobot, "tested": tested, "section": "cobots"}
     return render(request, "cobots/cobot_form.html", context, status=status)
@@ -155,7 +153,9 @@ def cobot_edit(request: HttpRequest, pk: int) -> HttpResponse:
 def _record(cobot: Cobot, by: Any, action: AdminAction, values: dict[str, Any]) -> None:
     # The credentials source names where the secret is, never the secret: safe to record.
     user = by if isinstance(by, User) else None
-    record_admin_action(cobot.organisation, user, action, cobot.name, {k: str(v) for k, v in values.items()})
+    record_admin_action(
+        cobot.organisation, user, action, cobot.name, {k: str(v) for k, v in values.items()}
+    )
 
 
 def _programs(cobot: Cobot, problems: list[str]) -> list[str]:

@@ -16,6 +16,13 @@ from hrc.organisations.models import Membership, Organisation, Team
 from hrc.organisations.validators import validate_cell
 
 
+class MemberChoices(forms.ModelMultipleChoiceField):  # type: ignore[type-arg]  # generic in django-stubs only
+    """Members shown by their username."""
+
+    def label_from_instance(self, obj: Any) -> str:
+        return str(obj.user.get_username())
+
+
 class _OrganisationForm(forms.Form):
     def __init__(self, organisation: Organisation, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -30,7 +37,6 @@ class _OrganisationForm(forms.Form):
                 .select_related("user")
                 .order_by("user__username")
             )
-            members.label_from_instance = lambda m: m.user.get_username()  # type: ignore[method-assign]
 
     def add_service_errors(self, error: ValidationError) -> None:
         """Puts a service's refusal at its field (or above the form when it names none)."""
@@ -60,7 +66,7 @@ class MemberForm(_OrganisationForm):
 
 class TeamForm(_OrganisationForm):
     name = forms.CharField(max_length=200)
-    members = forms.ModelMultipleChoiceField(
+    members = MemberChoices(
         queryset=Membership.objects.none(), required=False, widget=forms.CheckboxSelectMultiple
     )
 

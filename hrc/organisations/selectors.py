@@ -16,18 +16,14 @@ def memberships_of(user: AnyUser) -> QuerySet[Membership]:
     """The user's memberships with their organisations; empty for an anonymous user."""
     if not user.is_authenticated:
         return Membership.objects.none()
-    return Membership.objects.filter(user_id=user.pk, is_active=True).select_related(
-        "organisation"
-    )
+    return Membership.objects.filter(user_id=user.pk, is_active=True).select_related("organisation")
 
 
 def organisations_of(user: AnyUser) -> QuerySet[Organisation]:
     """The organisations whose data the user may read."""
     if not user.is_authenticated:
         return Organisation.objects.none()
-    return Organisation.objects.filter(
-        memberships__user_id=user.pk, memberships__is_active=True
-    )
+    return Organisation.objects.filter(memberships__user_id=user.pk, memberships__is_active=True)
 
 
 def writable_organisations(user: AnyUser) -> QuerySet[Organisation]:

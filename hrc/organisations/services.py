@@ -205,7 +205,9 @@ def _check_not_last_admin(membership: Membership, doing: str) -> None:
     ).exclude(pk=membership.pk)
     if membership.role == Role.ADMIN and not others.exists():
         raise ValidationError(
-            {"role": f"{membership.user} is the organisation's last admin and cannot be {doing}: make another admin first."}  # fmt: skip
+            {
+                "role": f"{membership.user} is the organisation's last admin and cannot be {doing}: make another admin first."
+            }
         )
 
 

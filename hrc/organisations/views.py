@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any
 
 from django.contrib.auth.decorators import login_required
+from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 from django.http import Http404, HttpRequest, HttpResponse, HttpResponseRedirect
 from django.shortcuts import render
@@ -95,7 +96,9 @@ def people(request: HttpRequest, admin: Membership) -> HttpResponse:
         if form.is_valid():
             try:
                 membership, password = services.add_person(
-                    organisation, by=request.user, **form.cleaned_data  # type: ignore[arg-type]
+                    organisation,
+                    by=admin.user,
+                    **form.cleaned_data,
                 )
             except ValidationError as error:
                 form.add_service_errors(error)
@@ -129,7 +132,7 @@ def person(request: HttpRequest, admin: Membership, pk: int) -> HttpResponse:
     if request.method == "POST":
         if form.is_valid():
             try:
-                _change_member(membership, form.cleaned_data, by=request.user)  # type: ignore[arg-type]
+                _change_member(membership, form.cleaned_data, by=admin.user)
             except ValidationError as error:
                 form.add_service_errors(error)
             else:
@@ -141,7 +144,7 @@ def person(request: HttpRequest, admin: Membership, pk: int) -> HttpResponse:
     )  # fmt: skip
 
 
-def _change_member(membership: Membership, data: dict[str, Any], *, by: Any) -> None:
+def _change_member(membership: Membership, data: dict[str, Any], *, by: User) -> None:
     if data["role"] != membership.role:
         services.change_member_role(membership, data["role"], by=by)
     if set(data["teams"]) != set(membership.teams.all()):
@@ -154,7 +157,7 @@ def deactivate_person(request: HttpRequest, admin: Membership, pk: int) -> HttpR
     """Deactivates the member; their open tasks go back to their candidates."""
     membership = _member(admin, pk)
     try:
-        handed_back = services.deactivate_member(membership, by=request.user)  # type: ignore[arg-type]
+        handed_back = services.deactivate_member(membership, by=admin.user)
     except ValidationError as error:
         return _page(
             request, "organisations/person.html", admin.organisation,
@@ -174,7 +177,7 @@ def reset_password(request: HttpRequest, admin: Membership, pk: int) -> HttpResp
     """Sets a new one-time password and shows it, once."""
     membership = _member(admin, pk)
     try:
-        password = services.reset_member_password(membership, by=request.user)  # type: ignore[arg-type]
+        password = services.reset_member_password(membership, by=admin.user)
     except ValidationError as error:
         raise Http404(" ".join(error.messages)) from None
     form = MemberForm(
@@ -200,7 +203,7 @@ def teams(request: HttpRequest, admin: Membership) -> HttpResponse:
     if request.method == "POST":
         if form.is_valid():
             try:
-                services.add_team(organisation, by=request.user, **form.cleaned_data)  # type: ignore[arg-type]
+                services.add_team(organisation, by=admin.user, **form.cleaned_data)
             except ValidationError as error:
                 form.add_service_errors(error)
             else:
@@ -230,11 +233,11 @@ def team(request: HttpRequest, admin: Membership, pk: int) -> HttpResponse:
     status = 200
     if request.method == "POST":
         if "delete" in request.POST:
-            services.remove_team(found, by=request.user)  # type: ignore[arg-type]
+            services.remove_team(found, by=admin.user)
             return HttpResponseRedirect(reverse("organisation:teams"))
         if form.is_valid():
             try:
-                services.change_team(found, by=request.user, **form.cleaned_data)  # type: ignore[arg-type]
+                services.change_team(found, by=admin.user, **form.cleaned_data)
             except ValidationError as error:
                 form.add_service_errors(error)
             else:
@@ -258,7 +261,7 @@ def cells(request: HttpRequest, admin: Membership) -> HttpResponse:
     if request.method == "POST":
         if form.is_valid():
             try:
-                services.add_cell(organisation, by=request.user, **form.cleaned_data)  # type: ignore[arg-type]
+                services.add_cell(organisation, by=admin.user, **form.cleaned_data)
             except ValidationError as error:
                 form.add_service_errors(error)
             else:
@@ -294,14 +297,14 @@ def cell(request: HttpRequest, admin: Membership, pk: int) -> HttpResponse:
     if request.method == "POST":
         if "delete" in request.POST:
             try:
-                services.remove_cell(found, by=request.user)  # type: ignore[arg-type]
+                services.remove_cell(found, by=admin.user)
             except ValidationError as error:
                 refusal, status = " ".join(error.messages), 400
             else:
                 return HttpResponseRedirect(reverse("organisation:cells"))
         elif form.is_valid():
             try:
-                services.describe_cell(found, by=request.user, **form.cleaned_data)  # type: ignore[arg-type]
+                services.describe_cell(found, by=admin.user, **form.cleaned_data)
             except ValidationError as error:
                 form.add_service_errors(error)
             else:

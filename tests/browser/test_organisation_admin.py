@@ -35,7 +35,8 @@ def test_an_admin_adds_an_operator_a_team_a_cell_and_a_cobot(
     admin: User,
     organisation: Organisation,
 ) -> None:
-    assert not admin.is_staff and not admin.is_superuser
+    assert not admin.is_staff
+    assert not admin.is_superuser
     page.set_viewport_size({"width": 1280, "height": 800})
     sign_in(page, admin)
 

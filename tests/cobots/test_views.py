@@ -136,7 +136,8 @@ def test_an_engineer_registers_a_cobot_in_one_of_the_organisations_cells(
     response = _client(engineer).post("/cobots/new/", _cobot_form(cell="weld"))
     assert response.status_code == 302
     cobot = Cobot.objects.get(name="cobot9")
-    assert cobot.organisation == organisation and cobot.cell == "weld"
+    assert cobot.organisation == organisation
+    assert cobot.cell == "weld"
     assert AdminRecord.objects.filter(target="cobot9", actor=engineer).exists()
 
 
@@ -157,7 +158,8 @@ def test_a_taken_name_and_a_bad_endpoint_are_refused_at_their_fields(
     response = _client(engineer).post("/cobots/new/", _cobot_form(endpoint="http://x"))
     text = response.content.decode()
     assert response.status_code == 400
-    assert "id_name-errors" in text and "id_endpoint-errors" in text
+    assert "id_name-errors" in text
+    assert "id_endpoint-errors" in text
     assert Cobot.objects.count() == 1
 
 
@@ -171,7 +173,8 @@ def test_an_engineer_edits_a_cobot_and_tests_its_connection(
     cobot.refresh_from_db()
     assert cobot.name == "renamed"
     tested = client.post(f"/cobots/{cobot.pk}/edit/", {"test": "1"})
-    assert tested.status_code == 200 and "did not answer" in tested.content.decode()
+    assert tested.status_code == 200
+    assert "did not answer" in tested.content.decode()
 
 
 def test_operators_are_refused_and_outsiders_find_no_cobot_to_edit(
@@ -183,4 +186,5 @@ def test_operators_are_refused_and_outsiders_find_no_cobot_to_edit(
     assert _client(outsider).get(f"/cobots/{cobot.pk}/edit/").status_code == 404
     assert _client(outsider).post(f"/cobots/{cobot.pk}/edit/", _cobot_form(name="y")).status_code == 404  # fmt: skip
     cobot.refresh_from_db()
-    assert cobot.name == "cobot9" and Cobot.objects.count() == 1
+    assert cobot.name == "cobot9"
+    assert Cobot.objects.count() == 1

@@ -95,5 +95,6 @@ def test_the_admin_site_refuses_staff_who_are_not_superusers(db: None) -> None:
     client = Client()
     client.force_login(staff)
     response = client.get("/admin/")
-    assert response.status_code == 302 and response["Location"].startswith("/admin/login/")
+    assert response.status_code == 302
+    assert response["Location"].startswith("/admin/login/")
     assert client.get("/admin/organisations/organisation/").status_code == 302

@@ -27,7 +27,12 @@ def test_an_admin_adds_a_member_and_reads_the_password_once(
     team = Team.objects.create(organisation=organisation, name="Crew")
     response = admin_client.post(
         "/api/members/",
-        {"organisation": organisation.pk, "username": "ada", "role": "operator", "teams": [team.pk]},
+        {
+            "organisation": organisation.pk,
+            "username": "ada",
+            "role": "operator",
+            "teams": [team.pk],
+        },
         format="json",
     )
     assert response.status_code == 201, response.data
@@ -39,7 +44,10 @@ def test_an_admin_adds_a_member_and_reads_the_password_once(
 
 
 def test_bad_member_input_names_the_field_and_writes_nothing(
-    admin_client: APIClient, organisation: Organisation, other_organisation: Organisation, operator: User
+    admin_client: APIClient,
+    organisation: Organisation,
+    other_organisation: Organisation,
+    operator: User,
 ) -> None:
     theirs = Team.objects.create(organisation=other_organisation, name="Theirs")
     users = User.objects.count()
@@ -52,10 +60,14 @@ def test_bad_member_input_names_the_field_and_writes_nothing(
     their_org = admin_client.post(
         "/api/members/", {"organisation": other_organisation.pk, "username": "bob", "role": "operator"}, format="json"
     )  # fmt: skip
-    assert taken.status_code == 400 and "username" in str(taken.data)
-    assert stranger_team.status_code == 400 and "teams" in str(stranger_team.data)
-    assert their_org.status_code == 400 and "organisation" in str(their_org.data)
-    assert User.objects.count() == users and not AdminRecord.objects.exists()
+    assert taken.status_code == 400
+    assert "username" in str(taken.data)
+    assert stranger_team.status_code == 400
+    assert "teams" in str(stranger_team.data)
+    assert their_org.status_code == 400
+    assert "organisation" in str(their_org.data)
+    assert User.objects.count() == users
+    assert not AdminRecord.objects.exists()
 
 
 def test_an_admin_changes_a_role_and_teams_resets_a_password_and_deactivates(
@@ -66,12 +78,14 @@ def test_an_admin_changes_a_role_and_teams_resets_a_password_and_deactivates(
     changed = admin_client.patch(
         f"/api/members/{membership.pk}/", {"role": "engineer", "teams": [team.pk]}, format="json"
     )
-    assert changed.status_code == 200 and changed.data["role"] == "engineer"
+    assert changed.status_code == 200
+    assert changed.data["role"] == "engineer"
     assert changed.data["teams"] == [team.pk]
     reset = admin_client.post(f"/api/members/{membership.pk}/reset-password/")
     assert APIClient().login(username=operator.username, password=reset.data["password"])
     gone = admin_client.post(f"/api/members/{membership.pk}/deactivate/")
-    assert gone.status_code == 200 and gone.data["is_active"] is False
+    assert gone.status_code == 200
+    assert gone.data["is_active"] is False
     operator.refresh_from_db()
     assert not operator.is_active
 
@@ -79,7 +93,8 @@ def test_an_admin_changes_a_role_and_teams_resets_a_password_and_deactivates(
 def test_the_last_admin_cannot_demote_themselves(admin_client: APIClient, admin: User) -> None:
     membership = Membership.objects.get(user=admin)
     response = admin_client.patch(f"/api/members/{membership.pk}/", {"role": "operator"}, format="json")  # fmt: skip
-    assert response.status_code == 400 and "last admin" in str(response.data)
+    assert response.status_code == 400
+    assert "last admin" in str(response.data)
     assert admin_client.post(f"/api/members/{membership.pk}/deactivate/").status_code == 400
 
 
@@ -101,15 +116,22 @@ def test_engineers_and_operators_may_read_but_not_write(
         assert client.delete(f"/api/cells/{cell.pk}/").status_code == 403
         assert client.get("/api/admin-records/").data["count"] == 0
     membership.refresh_from_db()
-    assert membership.role == Role.OPERATOR and membership.is_active
-    assert Team.objects.count() == 1 and Cell.objects.count() == 1
+    assert membership.role == Role.OPERATOR
+    assert membership.is_active
+    assert Team.objects.count() == 1
+    assert Cell.objects.count() == 1
     assert not User.objects.filter(username="x").exists()
 
 
 def test_an_admin_of_another_organisation_sees_and_changes_nothing(
-    admin_client: APIClient, organisation: Organisation, other_organisation: Organisation, operator: User
+    admin_client: APIClient,
+    organisation: Organisation,
+    other_organisation: Organisation,
+    operator: User,
 ) -> None:
-    admin_client.post("/api/teams/", {"organisation": organisation.pk, "name": "Crew"}, format="json")
+    admin_client.post(
+        "/api/teams/", {"organisation": organisation.pk, "name": "Crew"}, format="json"
+    )
     team = Team.objects.get(name="Crew")
     cell = Cell.objects.create(organisation=organisation, name="weld")
     membership = Membership.objects.get(user=operator)
@@ -120,12 +142,16 @@ def test_an_admin_of_another_organisation_sees_and_changes_nothing(
     for path in (f"/api/members/{membership.pk}/", f"/api/teams/{team.pk}/", f"/api/cells/{cell.pk}/"):  # fmt: skip
         assert stranger.get(path).status_code == 404
         assert stranger.patch(path, {"role": "admin", "name": "x", "description": "x"}, format="json").status_code == 404  # fmt: skip
-        assert stranger.delete(path).status_code in (404, 405)  # people are deactivated, not deleted
+        assert stranger.delete(path).status_code in (
+            404,
+            405,
+        )  # people are deactivated, not deleted
     for path in (f"/api/members/{membership.pk}/deactivate/", f"/api/members/{membership.pk}/reset-password/"):  # fmt: skip
         assert stranger.post(path).status_code == 404
     assert stranger.post("/api/cells/", {"organisation": organisation.pk, "name": "x"}, format="json").status_code == 400  # fmt: skip
     membership.refresh_from_db()
-    assert membership.is_active and Team.objects.filter(pk=team.pk, name="Crew").exists()
+    assert membership.is_active
+    assert Team.objects.filter(pk=team.pk, name="Crew").exists()
     assert Cell.objects.filter(organisation=organisation).count() == 1
 
 
@@ -134,9 +160,11 @@ def test_teams_and_cells_are_created_renamed_described_and_deleted(
 ) -> None:
     membership = Membership.objects.get(user=operator)
     team = admin_client.post("/api/teams/", {"organisation": organisation.pk, "name": "Crew", "members": [membership.pk]}, format="json")  # fmt: skip
-    assert team.status_code == 201 and team.data["members"] == [membership.pk]
+    assert team.status_code == 201
+    assert team.data["members"] == [membership.pk]
     renamed = admin_client.patch(f"/api/teams/{team.data['id']}/", {"name": "Night"}, format="json")
-    assert renamed.data["name"] == "Night" and renamed.data["members"] == [membership.pk]
+    assert renamed.data["name"] == "Night"
+    assert renamed.data["members"] == [membership.pk]
     assert admin_client.delete(f"/api/teams/{team.data['id']}/").status_code == 204
     cell = admin_client.post("/api/cells/", {"organisation": organisation.pk, "name": "weld"}, format="json")  # fmt: skip
     assert cell.status_code == 201
@@ -152,11 +180,13 @@ def test_a_bad_cell_name_and_a_cell_with_cobots_are_refused(
     admin_client: APIClient, organisation: Organisation
 ) -> None:
     bad = admin_client.post("/api/cells/", {"organisation": organisation.pk, "name": "cell 1"}, format="json")  # fmt: skip
-    assert bad.status_code == 400 and "name" in str(bad.data)
+    assert bad.status_code == 400
+    assert "name" in str(bad.data)
     make_cobot(organisation, name="welder", cell="weld")
     cell = Cell.objects.get(name="weld")
     kept = admin_client.delete(f"/api/cells/{cell.pk}/")
-    assert kept.status_code == 400 and "welder" in str(kept.data)
+    assert kept.status_code == 400
+    assert "welder" in str(kept.data)
     assert Cell.objects.filter(pk=cell.pk).exists()
 
 

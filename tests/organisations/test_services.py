@@ -109,6 +109,7 @@ def test_deactivating_an_operator_gives_their_claimed_and_started_tasks_back(
     assert handed_back == 2
     for item in (claimed, started):
         item = WorkItem.objects.get(pk=item.pk)
-        assert item.state == WorkItemState.OFFERED and item.claimed_by is None
+        assert item.state == WorkItemState.OFFERED
+        assert item.claimed_by is None
         event = CaseEvent.objects.filter(case_id=item.case_id, type=EventType.TASK_REASSIGNED).get()  # fmt: skip
         assert event.user == admin

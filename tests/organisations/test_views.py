@@ -39,11 +39,13 @@ def test_an_admin_adds_an_operator_who_signs_in_with_the_password_shown_once(
     password = re.search(r"<code>([^<]+)</code>", response.content.decode())
     assert password is not None
     membership = Membership.objects.get(user__username="ada", organisation=organisation)
-    assert membership.role == Role.OPERATOR and list(membership.teams.all()) == [team]
+    assert membership.role == Role.OPERATOR
+    assert list(membership.teams.all()) == [team]
     assert Client().login(username="ada", password=password.group(1))
     assert "<code>" not in page.get("/organisation/people/").content.decode()
     record = AdminRecord.objects.get(action=AdminAction.PERSON_ADDED)
-    assert record.target == "ada" and record.organisation == organisation
+    assert record.target == "ada"
+    assert record.organisation == organisation
 
 
 def test_a_taken_username_is_refused_at_its_field_and_nothing_is_written(
@@ -92,9 +94,10 @@ def test_an_admin_creates_and_deletes_a_team_and_a_cell(
     page: Client, organisation: Organisation, operator: User
 ) -> None:
     membership = Membership.objects.get(user=operator)
-    assert page.post(
-        "/organisation/teams/", {"name": "Crew", "members": [membership.pk]}
-    ).status_code == 302
+    assert (
+        page.post("/organisation/teams/", {"name": "Crew", "members": [membership.pk]}).status_code
+        == 302
+    )
     team = Team.objects.get(organisation=organisation, name="Crew")
     assert list(team.members.all()) == [membership]
     assert page.post(f"/organisation/teams/{team.pk}/", {"delete": "1"}).status_code == 302
@@ -106,16 +109,16 @@ def test_an_admin_creates_and_deletes_a_team_and_a_cell(
     assert {AdminAction.TEAM_CREATED, AdminAction.TEAM_DELETED, AdminAction.CELL_CREATED, AdminAction.CELL_DELETED} <= actions  # fmt: skip
 
 
-def test_the_last_admin_cannot_demote_or_deactivate_themselves(
-    page: Client, admin: User
-) -> None:
+def test_the_last_admin_cannot_demote_or_deactivate_themselves(page: Client, admin: User) -> None:
     membership = Membership.objects.get(user=admin)
     response = page.post(f"/organisation/people/{membership.pk}/", {"role": Role.ENGINEER})
-    assert response.status_code == 400 and "last admin" in response.content.decode()
+    assert response.status_code == 400
+    assert "last admin" in response.content.decode()
     response = page.post(f"/organisation/people/{membership.pk}/deactivate/")
     assert response.status_code == 400
     membership.refresh_from_db()
-    assert membership.role == Role.ADMIN and membership.is_active
+    assert membership.role == Role.ADMIN
+    assert membership.is_active
 
 
 def test_deactivating_a_person_with_no_other_organisation_stops_their_sign_in(
@@ -125,7 +128,8 @@ def test_deactivating_a_person_with_no_other_organisation_stops_their_sign_in(
     assert page.post(f"/organisation/people/{membership.pk}/deactivate/").status_code == 200
     membership.refresh_from_db()
     operator.refresh_from_db()
-    assert not membership.is_active and not operator.is_active
+    assert not membership.is_active
+    assert not operator.is_active
 
 
 def test_deactivating_keeps_the_sign_in_for_another_organisation(
@@ -153,7 +157,8 @@ def test_engineers_and_operators_are_refused(path: str, engineer: User, operator
     for user in (engineer, operator):
         assert _browser(user).get(path).status_code == 403
         assert _browser(user).post(path, {"name": "x", "username": "x", "role": "operator"}).status_code == 403  # fmt: skip
-    assert not Team.objects.exists() and not Cell.objects.exists()
+    assert not Team.objects.exists()
+    assert not Cell.objects.exists()
     assert not User.objects.filter(username="x").exists()
 
 
@@ -166,7 +171,9 @@ def test_an_admin_of_another_organisation_sees_nothing_of_this_one(
     stranger = _browser(make_member(other_organisation, Role.ADMIN))
     for path in ("/organisation/people/", "/organisation/teams/", "/organisation/cells/"):
         text = stranger.get(path).content.decode()
-        assert operator.username not in text and "Our crew" not in text and "ourcell" not in text
+        assert operator.username not in text
+        assert "Our crew" not in text
+        assert "ourcell" not in text
     for path in (
         f"/organisation/people/{membership.pk}/",
         f"/organisation/teams/{team.pk}/",
@@ -177,4 +184,5 @@ def test_an_admin_of_another_organisation_sees_nothing_of_this_one(
     for path in (f"/organisation/people/{membership.pk}/deactivate/", f"/organisation/people/{membership.pk}/reset-password/"):  # fmt: skip
         assert stranger.post(path).status_code == 404
     membership.refresh_from_db()
-    assert membership.is_active and Team.objects.filter(pk=team.pk).exists()
+    assert membership.is_active
+    assert Team.objects.filter(pk=team.pk).exists()

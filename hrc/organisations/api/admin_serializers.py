@@ -88,7 +88,9 @@ class CellSerializer(serializers.ModelSerializer[Cell]):
 
 
 class AdminRecordSerializer(serializers.ModelSerializer[AdminRecord]):
-    actor = serializers.SlugRelatedField(slug_field="username", read_only=True)
+    actor: serializers.SlugRelatedField[Any] = serializers.SlugRelatedField(
+        slug_field="username", read_only=True
+    )
 
     class Meta:
         model = AdminRecord

@@ -68,8 +68,6 @@ def _refused(error: DjangoValidationError) -> ValidationError:
 class _AdminsWrite:
     """Writes to an object need its organisation's admin; creating needs the named one's."""
 
-    request: Request
-
     def check_object_permissions(self, request: Request, obj: Any) -> None:
         super().check_object_permissions(request, obj)  # type: ignore[misc]
         if request.method not in ("GET", "HEAD", "OPTIONS"):
@@ -81,9 +79,10 @@ class _AdminsWrite:
         if not admin_organisations_of(request.user).exists():
             raise PermissionDenied(ADMINS_ONLY)
         wanted = request.data.get("organisation") if hasattr(request.data, "get") else None
-        if isinstance(wanted, int) or (isinstance(wanted, str) and wanted.isdigit()):
-            if organisations_of(request.user).filter(pk=int(wanted)).exists():
-                _check_admin(request, int(wanted))
+        if isinstance(wanted, str) and wanted.isdigit():
+            wanted = int(wanted)
+        if isinstance(wanted, int) and organisations_of(request.user).filter(pk=wanted).exists():
+            _check_admin(request, wanted)
 
 
 class MemberViewSet(
@@ -214,9 +213,9 @@ class CellViewSet(_AdminsWrite, viewsets.ModelViewSet[Cell]):
     lookup_value_regex = r"[0-9]+"
 
     def get_queryset(self) -> QuerySet[Cell]:
-        return Cell.objects.filter(
-            organisation__in=organisations_of(self.request.user)
-        ).order_by("organisation_id", "name")
+        return Cell.objects.filter(organisation__in=organisations_of(self.request.user)).order_by(
+            "organisation_id", "name"
+        )
 
     def create(self, request: Request, *args: Any, **kwargs: Any) -> Response:
         self._organisation_to_create_in(request)
