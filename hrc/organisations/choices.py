@@ -22,6 +22,8 @@ class AdminAction(models.TextChoices):
     """What an organisation's admin did; each write of the administration pages and API is one."""
 
     PERSON_ADDED = "person_added", "Added a person"
+    # The invited person chose their password through the invitation link (they are the actor).
+    INVITATION_ACCEPTED = "invitation_accepted", "Accepted the invitation"
     ROLE_CHANGED = "role_changed", "Changed a role"
     TEAMS_CHANGED = "teams_changed", "Changed a person's teams"
     PERSON_DEACTIVATED = "person_deactivated", "Deactivated a person"

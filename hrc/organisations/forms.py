@@ -55,6 +55,11 @@ class PersonForm(_OrganisationForm):
     teams = forms.ModelMultipleChoiceField(
         queryset=Team.objects.none(), required=False, widget=forms.CheckboxSelectMultiple
     )
+    invite = forms.BooleanField(
+        required=False,
+        label="Invitation link",
+        help_text="Instead of a password: a link, valid once and for a few days, where they choose their own.",
+    )
 
 
 class MemberForm(_OrganisationForm):

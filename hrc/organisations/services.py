@@ -11,8 +11,11 @@ from typing import Any
 
 from django.contrib.auth import get_user_model
 from django.contrib.auth.models import User
+from django.contrib.auth.tokens import default_token_generator
 from django.core.exceptions import ValidationError
 from django.db import transaction
+from django.utils.encoding import force_bytes
+from django.utils.http import urlsafe_base64_encode
 
 from hrc.organisations import hooks
 from hrc.organisations.choices import AdminAction, Role
@@ -164,19 +167,25 @@ def add_person(
     email: str = "",
     role: Role | str,
     teams: Iterable[Team] = (),
+    invite: bool = False,
 ) -> tuple[Membership, str]:
     """Creates a new user who belongs to the organisation with `role` and is in `teams`.
 
-    Returns the membership and the one-time password; the caller shows it once. The
-    username must be free, the teams the organisation's.
+    Returns the membership and the one-time password, which the caller shows once; with
+    `invite`, the user has no usable password yet and the second value is "" (the caller
+    hands over invitation_for(user) instead). The username must be free, the teams the
+    organisation's.
     """
     user_model = get_user_model()
     if user_model.objects.filter(username__iexact=username).exists():
         raise ValidationError({"username": f"The username {username} is taken."})
     first, _, last = name.strip().partition(" ")
     user = user_model(username=username, first_name=first, last_name=last, email=email)
-    password = one_time_password()
-    user.set_password(password)
+    password = "" if invite else one_time_password()
+    if invite:
+        user.set_unusable_password()
+    else:
+        user.set_password(password)
     user.full_clean()
     teams = list(teams)
     _check_teams(organisation, teams)
@@ -188,9 +197,39 @@ def add_person(
     membership.teams.set(teams)
     record_admin_action(
         organisation, by, AdminAction.PERSON_ADDED, username,
-        {"role": str(role), "teams": [t.name for t in teams]},
+        {"role": str(role), "teams": [t.name for t in teams], "invited": invite},
     )  # fmt: skip
     return membership, password
+
+
+def invitation_for(user: User) -> tuple[str, str]:
+    """The (uidb64, token) of the user's invitation link (organisation:join).
+
+    Django's password-reset token: signed with the secret key, it expires after
+    PASSWORD_RESET_TIMEOUT and is spent once the password changes, so it works once.
+    """
+    return urlsafe_base64_encode(force_bytes(user.pk)), default_token_generator.make_token(user)
+
+
+def invitation_valid(user: User, token: str) -> bool:
+    """Whether the invitation link still works: not used, not expired, the user not deactivated."""
+    return user.is_active and default_token_generator.check_token(user, token)
+
+
+@transaction.atomic
+def accept_invitation(user: User, token: str, password: str) -> None:
+    """Sets the invited user's own password; ValidationError when the token is spent or expired.
+
+    The caller has checked `password` with the password validators.
+    """
+    if not invitation_valid(user, token):
+        raise ValidationError({"token": "This invitation link has been used or has expired: ask your admin for a new one."})  # fmt: skip
+    user.set_password(password)
+    user.save(update_fields=["password"])
+    for membership in Membership.objects.filter(user=user, is_active=True).select_related("organisation"):  # fmt: skip
+        record_admin_action(
+            membership.organisation, user, AdminAction.INVITATION_ACCEPTED, user.username
+        )
 
 
 def _check_teams(organisation: Organisation, teams: Iterable[Team]) -> None:

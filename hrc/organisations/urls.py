@@ -19,6 +19,7 @@ urlpatterns = [
         views.reset_password,
         name="person-reset-password",
     ),
+    path("organisation/join/<str:uidb64>/<str:token>/", views.join, name="join"),
     path("organisation/teams/", views.teams, name="teams"),
     path("organisation/teams/<int:pk>/", views.team, name="team"),
     path("organisation/cells/", views.cells, name="cells"),

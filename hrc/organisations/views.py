@@ -12,11 +12,14 @@ from __future__ import annotations
 from typing import Any
 
 from django.contrib.auth.decorators import login_required
+from django.contrib.auth.forms import SetPasswordForm
 from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 from django.http import Http404, HttpRequest, HttpResponse, HttpResponseRedirect
 from django.shortcuts import render
 from django.urls import reverse
+from django.utils.encoding import force_str
+from django.utils.http import urlsafe_base64_decode
 from django.views.decorators.http import require_http_methods, require_POST
 
 from hrc.navigation import current_membership
@@ -104,6 +107,10 @@ def people(request: HttpRequest, admin: Membership) -> HttpResponse:
                 form.add_service_errors(error)
             else:
                 added = {"username": membership.user.username, "password": password}
+                if not password:
+                    added["invitation"] = request.build_absolute_uri(
+                        reverse("organisation:join", args=services.invitation_for(membership.user))
+                    )
                 form = PersonForm(organisation)
         if not form.is_valid() and added is None:
             status = 400
@@ -317,3 +324,28 @@ def cell(request: HttpRequest, admin: Membership, pk: int) -> HttpResponse:
         cell=found, form=form, refusal=refusal, status=status,
         occupants=hooks.cell_occupants(organisation.pk, found.name),
     )  # fmt: skip
+
+
+# The invitation link -------------------------------------------------------------
+
+
+@require_http_methods(["GET", "POST"])
+def join(request: HttpRequest, uidb64: str, token: str) -> HttpResponse:
+    """Where an invited person chooses their password, once, before the link expires."""
+    try:
+        user = User.objects.filter(pk=int(force_str(urlsafe_base64_decode(uidb64)))).first()
+    except (ValueError, TypeError):
+        user = None
+    if user is None or not services.invitation_valid(user, token):
+        context = {"message": "This invitation link has been used or has expired: ask your admin for a new one."}  # fmt: skip
+        return render(request, "organisations/join.html", context, status=404)
+    form = SetPasswordForm(user, request.POST or None)
+    if request.method == "POST" and form.is_valid():
+        try:
+            services.accept_invitation(user, token, form.cleaned_data["new_password1"])
+        except ValidationError as error:
+            form.add_error(None, error.messages)
+        else:
+            return HttpResponseRedirect(reverse("login") + "?joined=1")
+    status = 400 if form.errors else 200
+    return render(request, "organisations/join.html", {"form": form, "person": user}, status=status)

@@ -194,3 +194,16 @@ def test_stop_and_resume_still_reach_the_tablets_views(operator_client: APIClien
     assert resolve("/api/cells/stop/").func.view_class is StopCellView  # type: ignore[attr-defined]
     response = operator_client.post("/api/cells/stop/", {"cell": "nocobots"}, format="json")
     assert response.status_code not in (404, 405), response.content
+
+
+def test_an_invitation_is_answered_instead_of_a_password(
+    admin_client: APIClient, organisation: Organisation
+) -> None:
+    response = admin_client.post(
+        "/api/members/",
+        {"organisation": organisation.pk, "username": "ivy", "role": "operator", "invite": True},
+        format="json",
+    )
+    assert response.status_code == 201
+    assert "password" not in response.data
+    assert "/organisation/join/" in response.data["invitation"]

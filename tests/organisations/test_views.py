@@ -10,6 +10,7 @@ from django.test import Client
 
 from hrc.organisations.choices import AdminAction, Role
 from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation, Team
+from hrc.organisations.services import invitation_for
 from tests.factories import make_cobot, make_member
 
 pytestmark = pytest.mark.django_db
@@ -186,3 +187,34 @@ def test_an_admin_of_another_organisation_sees_nothing_of_this_one(
     membership.refresh_from_db()
     assert membership.is_active
     assert Team.objects.filter(pk=team.pk).exists()
+
+
+def test_an_invited_person_chooses_their_password_once_through_the_link(
+    page: Client, organisation: Organisation
+) -> None:
+    response = page.post(
+        "/organisation/people/", {"username": "ivy", "role": Role.OPERATOR, "invite": "on"}
+    )
+    link = re.search(r'<code id="invitation">http://testserver([^<]+)</code>', response.content.decode())  # fmt: skip
+    assert link is not None
+    ivy = User.objects.get(username="ivy")
+    assert not ivy.has_usable_password()
+    stranger = Client()
+    assert stranger.get(link.group(1)).status_code == 200
+    bad = stranger.post(link.group(1), {"new_password1": "short", "new_password2": "short"})
+    assert bad.status_code == 400
+    assert "id_new_password2-errors" in bad.content.decode()
+    chosen = "a-long-chosen-password-42"
+    done = stranger.post(link.group(1), {"new_password1": chosen, "new_password2": chosen})
+    assert done.status_code == 302
+    assert Client().login(username="ivy", password=chosen)
+    again = stranger.post(link.group(1), {"new_password1": "x" + chosen, "new_password2": "x" + chosen})  # fmt: skip
+    assert again.status_code == 404
+    assert Client().login(username="ivy", password=chosen)
+    assert AdminRecord.objects.filter(action=AdminAction.INVITATION_ACCEPTED, actor__username="ivy").exists()  # fmt: skip
+
+
+def test_a_forged_invitation_link_is_refused(page: Client, operator: User) -> None:
+    uid, _ = invitation_for(operator)
+    assert Client().get(f"/organisation/join/{uid}/forged-token/").status_code == 404
+    assert Client().get("/organisation/join/!!/forged-token/").status_code == 404

@@ -33,6 +33,8 @@ class MemberSerializer(serializers.Serializer[Membership]):
     role = serializers.ChoiceField(choices=Role.choices)
     teams = serializers.ListField(child=serializers.IntegerField(), required=False)
     is_active = serializers.BooleanField(read_only=True)
+    # True: answer with an invitation link (they choose their password) instead of a password.
+    invite = serializers.BooleanField(required=False, default=False, write_only=True)
 
     def to_representation(self, instance: Membership) -> dict[str, Any]:
         return {

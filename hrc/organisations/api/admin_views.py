@@ -13,6 +13,7 @@ from typing import Any
 from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError as DjangoValidationError
 from django.db.models import QuerySet
+from django.urls import reverse
 from drf_spectacular.utils import extend_schema
 from rest_framework import mixins, status, viewsets
 from rest_framework.decorators import action
@@ -92,7 +93,8 @@ class MemberViewSet(
     mixins.CreateModelMixin,
     viewsets.GenericViewSet[Membership],
 ):
-    """People of your organisations. Creating answers with their one-time password, once."""
+    """People of your organisations. Creating answers with their one-time password (or, with
+    `invite`, their invitation link), once."""
 
     serializer_class = MemberSerializer
 
@@ -115,7 +117,11 @@ class MemberViewSet(
             membership, password = services.add_person(organisation, by=_user(request), **data)
         except DjangoValidationError as error:
             raise _refused(error) from None
-        body = MemberSerializer(membership).data | {"password": password}
+        if password:
+            body = MemberSerializer(membership).data | {"password": password}
+        else:
+            link = reverse("organisation:join", args=services.invitation_for(membership.user))
+            body = MemberSerializer(membership).data | {"invitation": request.build_absolute_uri(link)}  # fmt: skip
         return Response(body, status=status.HTTP_201_CREATED)
 
     @extend_schema(request=MemberChangeSerializer, responses=MemberSerializer)
