@@ -9,6 +9,8 @@ from __future__ import annotations
 from typing import Any
 
 from django.db.models import QuerySet
+from drf_spectacular.types import OpenApiTypes
+from drf_spectacular.utils import extend_schema_field
 from rest_framework import serializers
 
 from hrc.organisations.choices import Role
@@ -16,6 +18,7 @@ from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation
 from hrc.organisations.selectors import admin_organisations_of
 
 
+@extend_schema_field(OpenApiTypes.INT)
 class AdminOrganisationField(serializers.PrimaryKeyRelatedField[Organisation]):
     """An organisation the requesting user is an admin of; any other id does not exist."""
 
