@@ -747,13 +747,17 @@ def _locked_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
         .filter(
             pk=Subquery(WorkItem.objects.filter(pk=item_id).values("case_id")),
             organisation__memberships__user_id=user.pk,
+            organisation__memberships__is_active=True,  # deactivated there: not theirs to do
         )
         .first()
     )
     if case is None:
         raise NotFound(f"There is no work item {item_id} in your organisations.")
     offered = WorkItem.objects.filter(
-        performable_by(user), pk=OuterRef("pk"), case__organisation__memberships__user_id=user.pk
+        performable_by(user),
+        pk=OuterRef("pk"),
+        case__organisation__memberships__user_id=user.pk,
+        case__organisation__memberships__is_active=True,
     )  # a candidate (or in the item's team) and still a member; read with the item in one query
     item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item_id)
     check_operator_task(item)

@@ -4,6 +4,7 @@ from django.core.exceptions import ValidationError
 
 from hrc.cases import services as case_services
 from hrc.cases.choices import EventType, WorkItemState
+from hrc.cases.errors import NotFound
 from hrc.cases.models import CaseEvent, WorkItem
 from hrc.organisations import services
 from hrc.organisations.choices import Role
@@ -113,3 +114,23 @@ def test_deactivating_an_operator_gives_their_claimed_and_started_tasks_back(
         assert item.claimed_by is None
         event = CaseEvent.objects.filter(case_id=item.case_id, type=EventType.TASK_REASSIGNED).get()  # fmt: skip
         assert event.user == admin
+
+
+def test_a_person_deactivated_here_but_active_elsewhere_cannot_claim_work_here(
+    organisation: Organisation,
+    other_organisation: Organisation,
+    engineer: User,
+    operator: User,
+    admin: User,
+) -> None:
+    services.add_member(other_organisation, operator, Role.OPERATOR)
+    version = factories.make_version(organisation, published_by=engineer)
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": factories.make_cobot(organisation).pk}}
+    case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    services.deactivate_member(Membership.objects.get(user=operator, organisation=organisation), by=admin)  # fmt: skip
+    operator.refresh_from_db()
+    assert operator.is_active  # still signs in for the other organisation
+
+    with pytest.raises(NotFound):
+        case_services.claim_work_item(factories.open_work_item(case, "to1"), user=operator)
+    assert factories.open_work_item(case, "to1").state == WorkItemState.OFFERED
