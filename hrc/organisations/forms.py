@@ -47,12 +47,19 @@ class _OrganisationForm(forms.Form):
             self.add_error(None, error.messages)
 
 
+class TeamChoices(forms.ModelMultipleChoiceField):  # type: ignore[type-arg]  # generic in django-stubs only
+    """Teams shown by their name (all are the admin's organisation's)."""
+
+    def label_from_instance(self, obj: Any) -> str:
+        return str(obj.name)
+
+
 class PersonForm(_OrganisationForm):
     username = forms.CharField(max_length=150, help_text="What they type to sign in.")
     name = forms.CharField(max_length=150, required=False, help_text="First and last name.")
     email = forms.EmailField(required=False, label="E-mail")
     role = forms.ChoiceField(choices=Role.choices, initial=Role.OPERATOR)
-    teams = forms.ModelMultipleChoiceField(
+    teams = TeamChoices(
         queryset=Team.objects.none(), required=False, widget=forms.CheckboxSelectMultiple
     )
     invite = forms.BooleanField(
@@ -64,7 +71,7 @@ class PersonForm(_OrganisationForm):
 
 class MemberForm(_OrganisationForm):
     role = forms.ChoiceField(choices=Role.choices)
-    teams = forms.ModelMultipleChoiceField(
+    teams = TeamChoices(
         queryset=Team.objects.none(), required=False, widget=forms.CheckboxSelectMultiple
     )
 

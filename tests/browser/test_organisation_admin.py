@@ -13,6 +13,7 @@ from playwright.sync_api import Browser, Page, expect
 
 from hrc.cobots.models import Cobot
 from hrc.organisations.models import Membership, Organisation, Team
+from tests import factories
 from tests.browser.conftest import assert_fits
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -96,3 +97,60 @@ def test_an_admin_adds_an_operator_a_team_a_cell_and_a_cobot(
     assert list(Team.objects.get(name="Morning shift").members.all()) == [membership]
     assert Cobot.objects.get(name="cobot7").cell == "cell1"
     assert re.fullmatch(r"[A-Za-z0-9_-]{16}", password)
+
+
+def test_the_detail_pages_and_the_invitation_fit_the_window(
+    page: Page,
+    browser: Browser,
+    live_url: str,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+    admin: User,
+    operator: User,
+    organisation: Organisation,
+) -> None:
+    membership = Membership.objects.get(user=operator)
+    team = Team.objects.create(organisation=organisation, name="Night shift")
+    team.members.add(membership)
+    factories.make_cobot(organisation, name="welder", cell="weld")
+    page.set_viewport_size({"width": 1280, "height": 800})
+    sign_in(page, admin)
+
+    page.goto(f"{live_url}/organisation/people/")
+    page.get_by_role("link", name=operator.username).click()
+    page.get_by_role("button", name="Reset the password").click()
+    expect(page.locator("#one-time-password code")).to_be_visible()
+    _shot(page, screenshot, "organisation-person")
+
+    page.goto(f"{live_url}/organisation/teams/")
+    page.get_by_role("link", name="Night shift").click()
+    expect(page.get_by_label(operator.username)).to_be_checked()
+    _shot(page, screenshot, "organisation-team")
+
+    page.goto(f"{live_url}/organisation/cells/")
+    page.get_by_role("link", name="weld", exact=True).click()
+    page.once("dialog", lambda dialog: dialog.accept())
+    page.get_by_role("button", name="Delete the cell").click()
+    expect(page.get_by_role("alert")).to_contain_text("welder")
+    _shot(page, screenshot, "organisation-cell")
+
+    page.goto(f"{live_url}/organisation/people/")
+    form = page.locator("#add-person")
+    form.get_by_label("Username", exact=True).fill("ivy")
+    form.get_by_label("Invitation link").check()
+    form.get_by_role("button", name="Add the person").click()
+    link = page.locator("#invitation").inner_text().strip()
+
+    invited = browser.new_context(viewport={"width": 1280, "height": 800}).new_page()
+    invited.goto(link)
+    expect(invited.get_by_role("heading", name="Welcome, ivy")).to_be_visible()
+    _shot(invited, screenshot, "organisation-join")
+    invited.get_by_label("New password", exact=True).fill("a-long-chosen-password-42")
+    invited.get_by_label("New password confirmation").fill("a-long-chosen-password-42")
+    invited.get_by_role("button", name="Set my password").click()
+    invited.wait_for_url(re.compile(r".*/accounts/login/.*"))
+    invited.get_by_label("User name").fill("ivy")
+    invited.get_by_label("Password").fill("a-long-chosen-password-42")
+    invited.get_by_role("button", name="Sign in").click()
+    invited.wait_for_url(f"{live_url}/")
+    invited.context.close()
