@@ -20,6 +20,7 @@ urlpatterns = [
     # /analytics/: figures per version, Gantt per case
     path("", include("hrc.analytics.urls")),
     path("", include("hrc.cobots.urls")),  # the cobot pages: /cobots/, control for engineers
+    path("", include("hrc.organisations.urls")),  # /organisation/: people, teams, cells
     # Sign-in, sign-out and password change for the tablets and the editor.
     path("accounts/", include("django.contrib.auth.urls")),
     path("api/schema/", SpectacularAPIView.as_view(), name="api-schema"),

@@ -45,7 +45,9 @@ class MappingForm(forms.Form):
         self.pattern = pattern
         teams = list(Team.objects.filter(organisation=organisation).order_by("name"))
         people = list(
-            User.objects.filter(memberships__organisation=organisation, is_active=True)
+            User.objects.filter(
+                memberships__organisation=organisation, memberships__is_active=True, is_active=True
+            )
             .order_by("username")
             .distinct()
         )

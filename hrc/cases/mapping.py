@@ -78,7 +78,7 @@ def _users(actor: str, organisation: Organisation, references: Any) -> list[int]
         )
     # A deactivated person signs in nowhere: a task offered to them would wait forever.
     members = get_user_model().objects.filter(
-        memberships__organisation=organisation, is_active=True
+        memberships__organisation=organisation, memberships__is_active=True, is_active=True
     )
     ids = []
     for reference in references:

@@ -99,7 +99,12 @@ def performers_of(item: WorkItem) -> QuerySet[User]:
         may |= Q(memberships__teams__id=item.team_id)
     organisation = item.case.organisation_id
     return (
-        User.objects.filter(may, is_active=True, memberships__organisation_id=organisation)
+        User.objects.filter(
+            may,
+            is_active=True,
+            memberships__organisation_id=organisation,
+            memberships__is_active=True,  # the same membership: not deactivated there
+        )
         .distinct()
         .order_by("username")
     )

@@ -812,13 +812,17 @@ def _locked_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
         .filter(
             pk=Subquery(WorkItem.objects.filter(pk=item_id).values("case_id")),
             organisation__memberships__user_id=user.pk,
+            organisation__memberships__is_active=True,  # deactivated there: not theirs to do
         )
         .first()
     )
     if case is None:
         raise NotFound(f"There is no work item {item_id} in your organisations.")
     offered = WorkItem.objects.filter(
-        performable_by(user), pk=OuterRef("pk"), case__organisation__memberships__user_id=user.pk
+        performable_by(user),
+        pk=OuterRef("pk"),
+        case__organisation__memberships__user_id=user.pk,
+        case__organisation__memberships__is_active=True,
     )  # a candidate (or in the item's team) and still a member; read with the item in one query
     item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item_id)
     check_operator_task(item)
@@ -872,3 +876,35 @@ def record_event(
         marking_after=dict(after) if after is not None else marking,
         detail=dict(detail or {}),
     )  # fmt: skip
+
+
+def hand_back_work_items(user: User, organisation_id: int, by: User | None) -> int:
+    """Gives every open operator task `user` holds in the organisation back to its candidates
+    (claimed and started alike: they are leaving), each with an event in its case's log.
+    Returns how many went back. Registered with hrc.organisations.hooks for deactivation.
+    """
+    held = WorkItem.objects.filter(
+        case__organisation_id=organisation_id,
+        claimed_by=user,
+        kind=WorkItemKind.OPERATOR,
+        state__in=[WorkItemState.CLAIMED, WorkItemState.RUNNING],
+    ).values_list("pk", "case_id")
+    handed_back = 0
+    for item_id, case_id in list(held):
+        with transaction.atomic():
+            case = lock_case(case_id)
+            item = WorkItem.objects.get(pk=item_id)
+            if item.claimed_by_id != user.pk or item.state not in (
+                WorkItemState.CLAIMED,
+                WorkItemState.RUNNING,
+            ):
+                continue  # moved on before the lock
+            item.state, item.claimed_by = WorkItemState.OFFERED, None
+            item.save(update_fields=["state", "claimed_by"])
+            record_event(
+                case, EventType.TASK_REASSIGNED, item=item, user=by,
+                detail={"from": user.get_username(), "to": None, "why": "deactivated"},
+            )  # fmt: skip
+            case.save()
+            handed_back += 1
+    return handed_back

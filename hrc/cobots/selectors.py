@@ -15,6 +15,15 @@ def cobots_visible_to(user: AnyUser) -> QuerySet[Cobot]:
     )
 
 
+def cobots_in_cell(organisation_id: int, cell: str) -> list[str]:
+    """The names of the organisation's cobots placed in the cell."""
+    return list(
+        Cobot.objects.filter(organisation_id=organisation_id, cell=cell)
+        .order_by("name")
+        .values_list("name", flat=True)
+    )
+
+
 def commands_of(cobot: Cobot) -> QuerySet[CobotCommand]:
     """The control commands people gave the cobot, newest first, with who gave them."""
     return CobotCommand.objects.filter(cobot=cobot).select_related("requested_by")

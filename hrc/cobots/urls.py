@@ -1,4 +1,4 @@
-"""The cobot pages: /cobots/ and /cobots/<id>/ (the API's routes are api/urls.py)."""
+"""The cobot pages: /cobots/, /cobots/<id>/, new/ and <id>/edit/ (the API's routes are api/urls.py)."""
 
 from django.urls import path
 
@@ -8,5 +8,7 @@ app_name = "cobots"
 
 urlpatterns = [
     path("cobots/", views.cobot_list, name="cobot-list"),
+    path("cobots/new/", views.cobot_new, name="cobot-new"),
     path("cobots/<int:pk>/", views.cobot_detail, name="cobot-detail"),
+    path("cobots/<int:pk>/edit/", views.cobot_edit, name="cobot-edit"),
 ]

@@ -1,4 +1,4 @@
-"""The cobot pages for engineers and admins: /cobots/ and /cobots/<id>/.
+"""The cobot pages for engineers and admins: /cobots/, /cobots/<id>/, new/ and <id>/edit/.
 
 Behind the organisation wall as the supervisor pages are: another
 organisation's cobot is a 404 whatever its id; in the organisation without
@@ -14,16 +14,23 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from django.contrib.auth.decorators import login_required
+from django.contrib.auth.models import User
+from django.core.exceptions import ValidationError
 from django.core.paginator import Paginator
-from django.http import Http404, HttpRequest, HttpResponse
+from django.http import Http404, HttpRequest, HttpResponse, HttpResponseRedirect
 from django.shortcuts import render
 from django.urls import reverse
+from django.views.decorators.http import require_http_methods
 
-from hrc.cobots import control, hooks, urua
+from hrc.cobots import control, hooks, services, urua
 from hrc.cobots.choices import ControlCommand
+from hrc.cobots.forms import CobotForm
 from hrc.cobots.models import Cobot
 from hrc.cobots.selectors import cobots_visible_to, commands_of, live_state
+from hrc.navigation import current_membership
+from hrc.organisations.choices import WRITER_ROLES, AdminAction
 from hrc.organisations.selectors import may_write_in, writable_organisations
+from hrc.organisations.services import record_admin_action
 
 ENGINEERS_ONLY = "Only engineers and admins of the organisation control its cobots."
 COMMANDS_PER_PAGE = 20
@@ -91,6 +98,64 @@ def cobot_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "script": _script(cobot),
     }
     return render(request, "cobots/cobot_detail.html", context)
+
+
+@require_http_methods(["GET", "POST"])
+@login_required
+def cobot_new(request: HttpRequest) -> HttpResponse:
+    """Registers a cobot in the organisation the engineer or admin works in."""
+    membership = current_membership(request)
+    if membership is None or membership.role not in WRITER_ROLES:
+        return _refused(request, 403, ENGINEERS_ONLY)
+    form = CobotForm(request.POST or None, instance=Cobot(organisation=membership.organisation))
+    if request.method == "POST" and form.is_valid():
+        try:
+            cobot = services.create_cobot(membership.organisation, **form.cleaned_data)
+        except ValidationError as error:
+            form.add_service_errors(error)
+        else:
+            _record(cobot, request.user, AdminAction.COBOT_REGISTERED, form.cleaned_data)
+            return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
+    status = 400 if form.errors else 200
+    context = {"form": form, "cobot": None, "section": "cobots"}
+    return render(request, "cobots/cobot_form.html", context, status=status)
+
+
+@require_http_methods(["GET", "POST"])
+@login_required
+def cobot_edit(request: HttpRequest, pk: int) -> HttpResponse:
+    """Changes a cobot's settings; the "test" button asks the cobot for its state instead."""
+    cobot = cobots_visible_to(request.user).filter(pk=pk).first()
+    if cobot is None:
+        raise Http404("No such cobot.")
+    if not may_write_in(request.user, cobot.organisation_id):
+        return _refused(request, 403, ENGINEERS_ONLY)
+    tested = None
+    if request.method == "POST" and "test" in request.POST:
+        tested = live_state(cobot)
+        form = CobotForm(instance=cobot)
+    else:
+        form = CobotForm(request.POST or None, instance=cobot)
+    if request.method == "POST" and tested is None and form.is_valid():
+        changes = {f: form.cleaned_data[f] for f in form.changed_data}
+        try:
+            services.update_cobot(cobot, **changes)
+        except ValidationError as error:
+            form.add_service_errors(error)
+        else:
+            _record(cobot, request.user, AdminAction.COBOT_CHANGED, changes)
+            return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
+    status = 400 if form.errors else 200
+    context = {"form": form, "cobot": cobot, "tested": tested, "section": "cobots"}
+    return render(request, "cobots/cobot_form.html", context, status=status)
+
+
+def _record(cobot: Cobot, by: Any, action: AdminAction, values: dict[str, Any]) -> None:
+    # The credentials source names where the secret is, never the secret: safe to record.
+    user = by if isinstance(by, User) else None
+    record_admin_action(
+        cobot.organisation, user, action, cobot.name, {k: str(v) for k, v in values.items()}
+    )
 
 
 def _programs(cobot: Cobot, problems: list[str]) -> list[str]:

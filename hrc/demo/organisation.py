@@ -29,11 +29,14 @@ TEAM_NAME = "Line operators"
 
 @dataclass(frozen=True)
 class Persona:
-    """A demo user: their role in the demo organisation and the pages they start from."""
+    """A demo user: their role in the demo organisation and the pages they start from.
+
+    Nobody is Django staff: the admin administers the organisation on its own pages
+    (/organisation/); /admin/ is for a superuser, whom the demo does not make.
+    """
 
     username: str
     role: Role
-    staff: bool = False
 
     @property
     def pages(self) -> tuple[str, ...]:
@@ -41,11 +44,11 @@ class Persona:
         if self.role == Role.OPERATOR:
             return ("/tablet/",)
         supervisor = ("/patterns/", "/cases/", "/incidents/", "/analytics/")
-        return (*supervisor, "/admin/") if self.staff else supervisor
+        return (*supervisor, "/organisation/people/") if self.role == Role.ADMIN else supervisor
 
 
 PERSONAS = (
-    Persona("admin", Role.ADMIN, staff=True),
+    Persona("admin", Role.ADMIN),
     Persona("engineer", Role.ENGINEER),
     Persona("operator1", Role.OPERATOR),
     Persona("operator2", Role.OPERATOR),
@@ -136,9 +139,7 @@ def _ensure_member(
         user = existing
     else:
         password = generate_password()
-        user = organisation_services.provision_user(
-            persona.username, password=password, is_staff=persona.staff, is_superuser=persona.staff
-        )
+        user = organisation_services.provision_user(persona.username, password=password)
     membership = Membership.objects.filter(organisation=organisation, user=user).first()
     if membership is None:
         organisation_services.add_member(organisation, user, persona.role)

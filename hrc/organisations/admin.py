@@ -16,7 +16,7 @@ from django.forms.models import BaseInlineFormSet
 from django.http import HttpRequest
 
 from hrc.organisations import services
-from hrc.organisations.models import Membership, Organisation, Team
+from hrc.organisations.models import AdminRecord, Membership, Organisation, Team
 
 # django-stubs types these classes as generics, Django's runtime classes are not
 # subscriptable (without the django-stubs-ext runtime patch, which is a dev-only package).
@@ -27,10 +27,12 @@ if TYPE_CHECKING:
     OrganisationAdminBase = admin.ModelAdmin[Organisation]
     MembershipAdminBase = admin.ModelAdmin[Membership]
     TeamAdminBase = admin.ModelAdmin[Team]
+    AdminRecordAdminBase = admin.ModelAdmin[AdminRecord]
 else:
     MembershipFormBase = TeamFormBase = forms.ModelForm
     MembershipInlineBase = admin.TabularInline
     OrganisationAdminBase = MembershipAdminBase = TeamAdminBase = admin.ModelAdmin
+    AdminRecordAdminBase = admin.ModelAdmin
 
 
 class MembershipInlineForm(MembershipFormBase):
@@ -109,15 +111,18 @@ class OrganisationAdmin(OrganisationAdminBase):
 
 @admin.register(Membership)
 class MembershipAdmin(MembershipAdminBase):
-    list_display = ["user", "organisation", "role", "joined_at"]
-    list_filter = ["role", "organisation"]
+    list_display = ["user", "organisation", "role", "is_active", "joined_at"]
+    list_filter = ["role", "is_active", "organisation"]
     search_fields = ["user__username", "user__email", "organisation__name"]
     autocomplete_fields = ["user", "organisation"]
     list_select_related = ["user", "organisation"]
 
     def get_readonly_fields(self, request: HttpRequest, obj: Membership | None = None) -> list[str]:
         # A membership is one person in one organisation; moving it would be a different one.
-        return ["user", "organisation", "joined_at"] if obj else ["joined_at"]
+        # Deactivating hands the person's tasks back: the organisation's people page does it.
+        if obj:
+            return ["user", "organisation", "is_active", "joined_at"]
+        return ["is_active", "joined_at"]
 
     def save_model(
         self, request: HttpRequest, obj: Membership, form: BaseModelForm[Membership], change: bool
@@ -199,3 +204,31 @@ class TeamAdmin(TeamAdminBase):
     def delete_queryset(self, request: HttpRequest, queryset: QuerySet[Team]) -> None:
         for team in queryset:
             services.delete_team(team)
+
+
+@admin.register(AdminRecord)
+class AdminRecordAdmin(AdminRecordAdminBase):
+    """The organisations' administration records, read only: they are what happened."""
+
+    list_display = ["at", "organisation", "actor", "action", "target"]
+    list_filter = ["action", "organisation"]
+    search_fields = ["target", "actor__username"]
+    list_select_related = ["organisation", "actor"]
+
+    def has_add_permission(self, request: HttpRequest) -> bool:
+        return False
+
+    def has_change_permission(self, request: HttpRequest, obj: AdminRecord | None = None) -> bool:
+        return False
+
+    def has_delete_permission(self, request: HttpRequest, obj: AdminRecord | None = None) -> bool:
+        return False
+
+
+def _superusers_only(request: HttpRequest) -> bool:
+    # The site shows every organisation at once, so it is for the people who run the
+    # installation. An organisation's admins administer it at /organisation/, inside its wall.
+    return bool(request.user.is_active and request.user.is_superuser)
+
+
+admin.site.has_permission = _superusers_only  # type: ignore[method-assign]

@@ -7,7 +7,7 @@ or change is decided by their Membership in that object's organisation.
 from django.conf import settings
 from django.db import models
 
-from hrc.organisations.choices import Role
+from hrc.organisations.choices import AdminAction, Role
 from hrc.organisations.validators import validate_cell
 
 
@@ -55,6 +55,10 @@ class Membership(models.Model):
         ),
     )
     joined_at = models.DateTimeField(auto_now_add=True, help_text="When the person was added.")
+    is_active = models.BooleanField(
+        default=True,
+        help_text="Whether the person still works here; a deactivated member sees nothing of the organisation.",
+    )
 
     class Meta:
         ordering = ["organisation__name", "user__username"]
@@ -133,3 +137,33 @@ class Cell(models.Model):
 
     def __str__(self) -> str:
         return self.name
+
+
+class AdminRecord(models.Model):
+    """One change an organisation's admin made (a person added, a team renamed): who, what, when."""
+
+    organisation = models.ForeignKey(
+        Organisation,
+        on_delete=models.CASCADE,
+        related_name="admin_records",
+        help_text="The organisation that was changed.",
+    )
+    actor = models.ForeignKey(
+        settings.AUTH_USER_MODEL,
+        on_delete=models.SET_NULL,
+        null=True,
+        related_name="+",
+        help_text="Who made the change; empty once that user is deleted.",
+    )
+    action = models.CharField(max_length=40, choices=AdminAction.choices)
+    target = models.CharField(
+        max_length=200, help_text="What was changed, by name (a username, a team, a cell)."
+    )
+    detail = models.JSONField(default=dict, blank=True, help_text="The values set.")
+    at = models.DateTimeField(auto_now_add=True, db_index=True)
+
+    class Meta:
+        ordering = ["-at", "-id"]
+
+    def __str__(self) -> str:
+        return f"{self.get_action_display()} {self.target}"

@@ -7,7 +7,7 @@ from django.contrib.auth.models import AbstractBaseUser, AnonymousUser
 from django.db.models import QuerySet
 
 from hrc.organisations.choices import WRITER_ROLES, Role
-from hrc.organisations.models import Cell, Membership, Organisation
+from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation, Team
 
 AnyUser = AbstractBaseUser | AnonymousUser
 
@@ -16,14 +16,14 @@ def memberships_of(user: AnyUser) -> QuerySet[Membership]:
     """The user's memberships with their organisations; empty for an anonymous user."""
     if not user.is_authenticated:
         return Membership.objects.none()
-    return Membership.objects.filter(user_id=user.pk).select_related("organisation")
+    return Membership.objects.filter(user_id=user.pk, is_active=True).select_related("organisation")
 
 
 def organisations_of(user: AnyUser) -> QuerySet[Organisation]:
     """The organisations whose data the user may read."""
     if not user.is_authenticated:
         return Organisation.objects.none()
-    return Organisation.objects.filter(memberships__user_id=user.pk)
+    return Organisation.objects.filter(memberships__user_id=user.pk, memberships__is_active=True)
 
 
 def writable_organisations(user: AnyUser) -> QuerySet[Organisation]:
@@ -32,7 +32,9 @@ def writable_organisations(user: AnyUser) -> QuerySet[Organisation]:
         return Organisation.objects.none()
     # One filter() call: both conditions must hold for the same membership row.
     return Organisation.objects.filter(
-        memberships__user_id=user.pk, memberships__role__in=WRITER_ROLES
+        memberships__user_id=user.pk,
+        memberships__role__in=WRITER_ROLES,
+        memberships__is_active=True,
     )
 
 
@@ -50,3 +52,41 @@ def may_write_in(user: AnyUser, organisation_id: int) -> bool:
 def cells_of(organisation_id: int) -> QuerySet[Cell]:
     """The organisation's cells by name."""
     return Cell.objects.filter(organisation_id=organisation_id).order_by("name")
+
+
+def is_admin_of(user: AnyUser, organisation_id: int) -> bool:
+    """Whether the user is an active admin of the organisation (the administration's check)."""
+    return role_in(user, organisation_id) == Role.ADMIN
+
+
+def members_of(organisation_id: int) -> QuerySet[Membership]:
+    """Everyone who is or was a member, with their user and teams, active ones first."""
+    return (
+        Membership.objects.filter(organisation_id=organisation_id)
+        .select_related("user")
+        .prefetch_related("teams")
+        .order_by("-is_active", "user__username")
+    )
+
+
+def teams_of(organisation_id: int) -> QuerySet[Team]:
+    """The organisation's teams by name, with their members' users."""
+    return (
+        Team.objects.filter(organisation_id=organisation_id)
+        .prefetch_related("members__user")
+        .order_by("name")
+    )
+
+
+def admin_records_of(organisation_id: int) -> QuerySet[AdminRecord]:
+    """The organisation's administration record, latest first."""
+    return AdminRecord.objects.filter(organisation_id=organisation_id).select_related("actor")
+
+
+def admin_organisations_of(user: AnyUser) -> QuerySet[Organisation]:
+    """The organisations the user is an active admin of."""
+    if not user.is_authenticated:
+        return Organisation.objects.none()
+    return Organisation.objects.filter(
+        memberships__user_id=user.pk, memberships__role=Role.ADMIN, memberships__is_active=True
+    )

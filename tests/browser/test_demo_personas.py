@@ -66,7 +66,7 @@ CHECKS: dict[str, Callable[[Page], None]] = {
     "/cases/": _heading("Cases"),
     "/incidents/": lambda page: expect(page.locator("#live-status")).to_have_text("Live"),
     "/analytics/": _heading("Analytics"),
-    "/admin/": _heading("Site administration"),
+    "/organisation/people/": _heading("People of Demo plant"),
 }
 
 

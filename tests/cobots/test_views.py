@@ -14,7 +14,7 @@ from django.test import Client
 from hrc.cases import jobs
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot, CobotCommand
-from hrc.organisations.models import Organisation
+from hrc.organisations.models import AdminRecord, Cell, Organisation
 from tests import factories
 from tests.cobots.simulator import PROGRAM
 
@@ -117,3 +117,74 @@ def test_the_list_counts_only_the_queue_of_each_cobot(
 
     assert '<td class="count nonzero">1</td>' in page.split(f'data-cobot="{cobot.pk}"')[1]
     assert '<td class="count">0</td>' in page.split(f'data-cobot="{other.pk}"')[1]
+
+
+# Registering and editing ---------------------------------------------------------
+
+
+def _cobot_form(**changes: object) -> dict[str, object]:
+    return {
+        "name": "cobot9", "driver": "simulated", "endpoint": "opc.tcp://127.0.0.1:4899",
+        "credentials_source": "none", "cell": "", "is_active": "on",
+    } | changes  # fmt: skip
+
+
+def test_an_engineer_registers_a_cobot_in_one_of_the_organisations_cells(
+    engineer: User, organisation: Organisation
+) -> None:
+    Cell.objects.create(organisation=organisation, name="weld")
+    response = _client(engineer).post("/cobots/new/", _cobot_form(cell="weld"))
+    assert response.status_code == 302
+    cobot = Cobot.objects.get(name="cobot9")
+    assert cobot.organisation == organisation
+    assert cobot.cell == "weld"
+    assert AdminRecord.objects.filter(target="cobot9", actor=engineer).exists()
+
+
+def test_another_organisations_cell_is_refused_at_the_field(
+    engineer: User, other_organisation: Organisation
+) -> None:
+    Cell.objects.create(organisation=other_organisation, name="theirs")
+    response = _client(engineer).post("/cobots/new/", _cobot_form(cell="theirs"))
+    assert response.status_code == 400
+    assert "id_cell-errors" in response.content.decode()
+    assert not Cobot.objects.exists()
+
+
+def test_a_taken_name_and_a_bad_endpoint_are_refused_at_their_fields(
+    engineer: User, organisation: Organisation
+) -> None:
+    factories.make_cobot(organisation, name="cobot9")
+    response = _client(engineer).post("/cobots/new/", _cobot_form(endpoint="http://x"))
+    text = response.content.decode()
+    assert response.status_code == 400
+    assert "id_name-errors" in text
+    assert "id_endpoint-errors" in text
+    assert Cobot.objects.count() == 1
+
+
+def test_an_engineer_edits_a_cobot_and_tests_its_connection(
+    engineer: User, organisation: Organisation
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot9", endpoint="opc.tcp://127.0.0.1:9")
+    client = _client(engineer)
+    response = client.post(f"/cobots/{cobot.pk}/edit/", _cobot_form(name="renamed"))
+    assert response.status_code == 302
+    cobot.refresh_from_db()
+    assert cobot.name == "renamed"
+    tested = client.post(f"/cobots/{cobot.pk}/edit/", {"test": "1"})
+    assert tested.status_code == 200
+    assert "did not answer" in tested.content.decode()
+
+
+def test_operators_are_refused_and_outsiders_find_no_cobot_to_edit(
+    operator: User, outsider: User, organisation: Organisation
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot9")
+    assert _client(operator).post("/cobots/new/", _cobot_form(name="x")).status_code == 403
+    assert _client(operator).get(f"/cobots/{cobot.pk}/edit/").status_code == 403
+    assert _client(outsider).get(f"/cobots/{cobot.pk}/edit/").status_code == 404
+    assert _client(outsider).post(f"/cobots/{cobot.pk}/edit/", _cobot_form(name="y")).status_code == 404  # fmt: skip
+    cobot.refresh_from_db()
+    assert cobot.name == "cobot9"
+    assert Cobot.objects.count() == 1

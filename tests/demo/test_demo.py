@@ -243,6 +243,8 @@ def _check_personas(demo: DemoRun) -> None:
         if persona.role == "operator":
             assert person.get("/cases/")[0] == 403
             assert person.get("/admin/")[1].startswith(f"{demo.url}/admin/login/")
+        if persona.role == "admin":  # an organisation admin, not Django staff
+            assert person.get("/admin/")[1].startswith(f"{demo.url}/admin/login/")
 
 
 async def _reachable_cobots(demo: DemoRun, username: str, timeout: float = 60.0) -> set[str]:

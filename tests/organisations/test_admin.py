@@ -2,7 +2,8 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
-from hrc.organisations.models import Membership, Organisation, Team
+from hrc.organisations import services
+from hrc.organisations.models import AdminRecord, Membership, Organisation, Team
 from tests import factories
 
 
@@ -87,3 +88,23 @@ def test_a_team_cannot_take_members_of_another_organisation(
     assert response.status_code == 200  # the form comes back with the error
     assert "Only members of Home plant" in response.content.decode()
     assert not Team.objects.exists()
+
+
+def test_the_admin_site_refuses_staff_who_are_not_superusers(db: None) -> None:
+    staff = services.provision_user("clerk", password="a-test-password", is_staff=True)
+    client = Client()
+    client.force_login(staff)
+    response = client.get("/admin/")
+    assert response.status_code == 302
+    assert response["Location"].startswith("/admin/login/")
+    assert client.get("/admin/organisations/organisation/").status_code == 302
+
+
+def test_a_superuser_reads_the_administration_records_but_cannot_change_them(
+    staff_client: Client, organisation: Organisation
+) -> None:
+    record = services.add_cell(organisation, by=factories.make_user(), name="weld")
+    assert staff_client.get("/admin/organisations/adminrecord/").status_code == 200
+    entry = AdminRecord.objects.get(target=record.name)
+    assert staff_client.post(f"/admin/organisations/adminrecord/{entry.pk}/delete/", {"post": "yes"}).status_code == 403  # fmt: skip
+    assert AdminRecord.objects.filter(pk=entry.pk).exists()

@@ -2,6 +2,10 @@ import pytest
 from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 
+from hrc.cases import services as case_services
+from hrc.cases.choices import EventType, WorkItemState
+from hrc.cases.errors import NotFound
+from hrc.cases.models import CaseEvent, WorkItem
 from hrc.organisations import services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
@@ -86,3 +90,47 @@ def test_selectors_see_only_the_users_own_organisations(
     assert list(writable_organisations(operator)) == []
     assert list(writable_organisations(engineer)) == [organisation]
     assert role_in(engineer, other_organisation.pk) is None
+
+
+# Deactivation hands the person's tasks back ---------------------------------------
+
+
+def test_deactivating_an_operator_gives_their_claimed_and_started_tasks_back(
+    organisation: Organisation, engineer: User, operator: User, admin: User
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer)
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": factories.make_cobot(organisation).pk}}
+    claimed_case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    started_case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    claimed = case_services.claim_work_item(factories.open_work_item(claimed_case, "to1"), user=operator)  # fmt: skip
+    started = case_services.start_work_item(factories.open_work_item(started_case, "to1"), user=operator)  # fmt: skip
+
+    handed_back = services.deactivate_member(Membership.objects.get(user=operator), by=admin)
+
+    assert handed_back == 2
+    for item in (claimed, started):
+        item = WorkItem.objects.get(pk=item.pk)
+        assert item.state == WorkItemState.OFFERED
+        assert item.claimed_by is None
+        event = CaseEvent.objects.filter(case_id=item.case_id, type=EventType.TASK_REASSIGNED).get()  # fmt: skip
+        assert event.user == admin
+
+
+def test_a_person_deactivated_here_but_active_elsewhere_cannot_claim_work_here(
+    organisation: Organisation,
+    other_organisation: Organisation,
+    engineer: User,
+    operator: User,
+    admin: User,
+) -> None:
+    services.add_member(other_organisation, operator, Role.OPERATOR)
+    version = factories.make_version(organisation, published_by=engineer)
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": factories.make_cobot(organisation).pk}}
+    case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    services.deactivate_member(Membership.objects.get(user=operator, organisation=organisation), by=admin)  # fmt: skip
+    operator.refresh_from_db()
+    assert operator.is_active  # still signs in for the other organisation
+
+    with pytest.raises(NotFound):
+        case_services.claim_work_item(factories.open_work_item(case, "to1"), user=operator)
+    assert factories.open_work_item(case, "to1").state == WorkItemState.OFFERED

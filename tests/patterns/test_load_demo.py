@@ -48,8 +48,9 @@ def test_it_creates_the_demo_plant_with_people_who_can_sign_in() -> None:
         assert username not in password
     assert len(set(passwords.values())) == len(passwords)
     admin = User.objects.get(username="admin")
-    assert admin.is_staff
-    assert admin.is_superuser
+    # An organisation admin, who administers at /organisation/; /admin/ is for superusers.
+    assert not admin.is_staff
+    assert not admin.is_superuser
     assert not User.objects.get(username="operator1").is_staff
     team = Team.objects.get(organisation=organisation)
     assert sorted(team.members.values_list("user__username", flat=True)) == [

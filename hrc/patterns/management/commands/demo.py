@@ -42,7 +42,7 @@ PAGES = (
     ("supervisor", "/cases/", "engineers, admins"),
     ("incidents", "/incidents/", "engineers, admins"),
     ("analytics", "/analytics/", "engineers, admins"),
-    ("admin", "/admin/", "the admin"),
+    ("administration", "/organisation/people/", "the admin"),
     ("API", "/api/docs/", "anyone signed in; machines with a token"),
 )
 

@@ -1,0 +1,50 @@
+"""The form that registers or edits a cobot; hrc.cobots.services writes it.
+
+The cell is chosen among the organisation's cells, so another organisation's
+cell (or a mistyped one) is "not one of the choices" at its field.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from django import forms
+from django.core.exceptions import ValidationError
+
+from hrc.cobots.models import Cobot
+from hrc.organisations.selectors import cells_of
+
+
+class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs makes it generic, Django does not
+    cell = forms.ChoiceField(
+        required=False,
+        help_text="The cell it stands in; its tablet shows and stops it. Add cells under Organisation → Cells.",
+    )
+
+    class Meta:
+        model = Cobot
+        fields = ["name", "driver", "endpoint", "credentials_source", "cell", "is_active"]
+
+    def __init__(self, data: Any = None, *, instance: Cobot) -> None:
+        super().__init__(data, instance=instance)
+        names = list(cells_of(instance.organisation_id).values_list("name", flat=True))
+        if instance.cell and instance.cell not in names:
+            names.append(instance.cell)
+        cell = self.fields["cell"]
+        assert isinstance(cell, forms.ChoiceField)
+        cell.choices = [("", "– the whole floor –"), *((name, name) for name in names)]
+
+    def clean_name(self) -> str:
+        name: str = self.cleaned_data["name"]
+        taken = Cobot.objects.filter(organisation_id=self.instance.organisation_id, name=name)
+        if taken.exclude(pk=self.instance.pk).exists():
+            raise ValidationError(f"The organisation already has a cobot named {name}.")
+        return name
+
+    def add_service_errors(self, error: ValidationError) -> None:
+        """Puts a service's refusal at its field (or above the form when it names none)."""
+        if hasattr(error, "error_dict"):
+            for field, messages in error.message_dict.items():
+                self.add_error(field if field in self.fields else None, messages)
+        else:
+            self.add_error(None, error.messages)

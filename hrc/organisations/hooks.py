@@ -1,0 +1,47 @@
+"""What the organisations app asks of the apps above it, through functions they register.
+
+Imports point inwards: cases imports organisations, never the other way. Yet
+when an admin deactivates a person, the tasks that person holds must go back
+to their team, and only the cases app knows them; before a cell is deleted,
+only the cobots app knows who stands in it. Each registers its answer in its
+AppConfig.ready() (hrc.cases.apps, hrc.cobots.apps); nothing registered means
+nothing held and nobody standing there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from django.contrib.auth.models import User
+
+# Gives back every open task `user` holds in the organisation (id), recorded as done by `by`;
+# returns how many went back.
+HandBack = Callable[[User, int, User | None], int]
+
+# The names of the cobots standing in the organisation's (id) cell of that name.
+Occupants = Callable[[int, str], list[str]]
+
+_HAND_BACK: list[HandBack] = []
+_OCCUPANTS: list[Occupants] = []
+
+
+def register_member_leaving(hand_back: HandBack) -> None:
+    """Called once by the app that runs cases, from its AppConfig.ready()."""
+    if hand_back not in _HAND_BACK:
+        _HAND_BACK.append(hand_back)
+
+
+def hand_back_work(user: User, organisation_id: int, by: User | None) -> int:
+    """Asks every registered app to give back what `user` holds; the number of tasks given back."""
+    return sum(hand_back(user, organisation_id, by) for hand_back in _HAND_BACK)
+
+
+def register_cell_occupants(occupants: Occupants) -> None:
+    """Called once by the app that places things in cells, from its AppConfig.ready()."""
+    if occupants not in _OCCUPANTS:
+        _OCCUPANTS.append(occupants)
+
+
+def cell_occupants(organisation_id: int, cell: str) -> list[str]:
+    """Every registered app's names of what stands in the cell, sorted."""
+    return sorted(name for occupants in _OCCUPANTS for name in occupants(organisation_id, cell))
