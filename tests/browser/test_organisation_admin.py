@@ -57,7 +57,7 @@ def test_an_admin_adds_an_operator_a_team_a_cell_and_a_cobot(
     operator_page.get_by_label("User name").fill("otto")
     operator_page.get_by_label("Password").fill(password)
     operator_page.get_by_role("button", name="Sign in").click()
-    operator_page.wait_for_url(f"{live_url}/")
+    operator_page.wait_for_url(f"{live_url}/tablet/")  # an operator lands on the tablet
     operator_page.context.close()
 
     page.goto(f"{live_url}/organisation/teams/")
@@ -152,5 +152,5 @@ def test_the_detail_pages_and_the_invitation_fit_the_window(
     invited.get_by_label("User name").fill("ivy")
     invited.get_by_label("Password").fill("a-long-chosen-password-42")
     invited.get_by_role("button", name="Sign in").click()
-    invited.wait_for_url(f"{live_url}/")
+    expect(invited).not_to_have_url(re.compile(r"/accounts/login/"))  # signed in, sent on
     invited.context.close()
