@@ -223,7 +223,7 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     expect(_badge(page)).to_have_attribute("data-sound", "false", timeout=CHECKED)
     for task in ("tc2", "to1"):
         expect(page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')).to_be_visible()
-    deadlock = page.locator(".hrc-issue", has_text="can deadlock")
+    deadlock = page.locator(".hrc-issue", has_text="can get stuck")
     expect(deadlock.locator(".hrc-witness-steps li")).to_have_text(
         ["t1", "start tc1", "complete tc1"]
     )
