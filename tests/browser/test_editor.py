@@ -230,7 +230,7 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     deadlock.get_by_role("button", name="Play the witness").click()
     bar = page.get_by_role("toolbar", name="Token game")
     for _ in range(3):
-        bar.get_by_role("button", name="Forward ▶").click()
+        bar.get_by_role("button", name="Fire next step ↷").click()
     expect(bar.locator(".hrc-game-caption")).to_contain_text("Witness replayed (3 of 3)")
     # Where the witness ends: tc1 has completed, tc2 and to1 wait for each other.
     expect(page.locator('.djs-element[data-element-id="tc1"]')).not_to_have_class(RUNNING)
@@ -455,38 +455,46 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
     page.get_by_role("button", name="Token game").click()
     bar = page.get_by_role("toolbar", name="Token game")
     caption = bar.locator(".hrc-game-caption")
-    expect(caption).to_have_text("Enabled: t1.")
+    expect(caption).to_have_text("Can fire: t1.")
 
     def tokens(place: str) -> Any:
         return page.locator(f'.djs-element[data-element-id="{place}"] .hrc-token')
 
     expect(tokens("p1")).to_have_count(1)
     _click(page, "tc1")  # not enabled yet: nothing happens
-    expect(caption).to_have_text("Enabled: t1.")
+    expect(caption).to_have_text("Can fire: t1.")
     _click(page, "t1")
     expect(tokens("p1")).to_have_count(0)
     expect(tokens("p2")).to_have_count(1)
     _click(page, "tc1")
     expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
-    expect(caption).to_contain_text("Fired start tc1.")
+    expect(caption).to_contain_text("Fired: start “pick insert”.")
     _click(page, "tc1")
-    expect(caption).to_contain_text("Fired complete tc1.")
+    expect(caption).to_contain_text("Fired: complete “pick insert”.")
     expect(tokens("p3")).to_have_count(1)
 
     # The constraint places, on demand: tc2 waits for to1's completion.
     bar.get_by_label("Constraint places").check()
     expect(page.locator(".hrc-constraint-place", has_text="to1 done, for tc2: 0")).to_be_visible()
+    # A click on the held-back task says which constraint holds it and whose task it waits for.
     _click(page, "tc2")
     expect(page.locator('.djs-element[data-element-id="tc2"]')).not_to_have_class(RUNNING)
+    expect(caption).to_have_text(
+        "“place insert” cannot start yet, held back by the time constraint "
+        "“prepare workpiece” → “place insert”: it waits for o's “prepare workpiece” to complete."
+    )
+    expect(page.locator('.djs-element[data-element-id="to1"]')).to_have_class(re.compile("hrc-awaited"))
     screenshot(page, "editor-token-game")
 
-    bar.get_by_role("button", name="◀ Back").click()
+    # Back and forward are undo and redo of firings.
+    expect(bar.get_by_role("button", name="Redo firing ↷")).to_be_disabled()
+    bar.get_by_role("button", name="↶ Undo firing").click()
     expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
-    bar.get_by_role("button", name="Forward ▶").click()
+    bar.get_by_role("button", name="Redo firing ↷").click()
     expect(tokens("p3")).to_have_count(1)
 
-    bar.get_by_role("button", name="Run randomly").click()
-    expect(caption).to_contain_text("Nothing is enabled.", timeout=20_000)
+    bar.get_by_role("button", name="Fire randomly").click()
+    expect(caption).to_contain_text("Nothing can fire.", timeout=20_000)
     expect(tokens("p9")).to_have_count(1)
     # Nothing was edited by playing.
     bar.get_by_role("button", name="Stop").click()

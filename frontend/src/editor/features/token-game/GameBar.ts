@@ -25,9 +25,12 @@ export default class GameBar {
       this.bar.appendChild(button);
       return button;
     };
-    add("◀ Back", () => tokenGame.back());
-    add("Forward ▶", () => tokenGame.forward());
-    add("Run randomly", () => tokenGame.runRandomly());
+    // Back and forward step through the firings already made: undo and redo, not "fire".
+    const undo = add("↶ Undo firing", () => tokenGame.back());
+    undo.title = "Take back the last firing";
+    const redo = add("Redo firing ↷", () => tokenGame.forward());
+    redo.title = "Fire again the firing just undone, or the witness' next step";
+    add("Fire randomly", () => tokenGame.runRandomly()).title = "Fire enabled tasks at random until nothing can fire";
     add("Reset", () => tokenGame.reset());
     const toggle = document.createElement("label");
     toggle.innerHTML = '<input type="checkbox"> Constraint places';
@@ -45,6 +48,12 @@ export default class GameBar {
       this.bar.hidden = true;
       box.checked = false;
     });
-    eventBus.on("tokenGame.changed", (event: { caption: string }) => (this.caption.textContent = event.caption));
+    eventBus.on("tokenGame.changed", (event: { caption: string }) => {
+      this.caption.textContent = event.caption;
+      const game = tokenGame.game;
+      undo.disabled = !game || game.history.length === 0;
+      redo.disabled = !game || game.future.length === 0;
+      redo.textContent = tokenGame.replaying ? "Fire next step ↷" : "Redo firing ↷";
+    });
   }
 }

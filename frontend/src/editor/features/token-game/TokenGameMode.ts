@@ -13,12 +13,13 @@ import type Overlays from "diagram-js/lib/features/overlays/Overlays";
 import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
 import type { Api } from "../../api";
-import { type NetTransition, readExecutionNet, TokenGame } from "../../model/net";
+import { heldBackWords, type NetTransition, readExecutionNet, TokenGame } from "../../model/net";
 import { isConstraint, isNode, objectOf } from "../../core/elements";
+import { quotedName } from "../../model/words";
 import type PatternImporter from "../../core/PatternImporter";
 
 const OVERLAY = "hrc-game";
-const MARKERS = ["hrc-enabled", "hrc-running", "hrc-fired", "hrc-stuck"];
+const MARKERS = ["hrc-enabled", "hrc-running", "hrc-fired", "hrc-stuck", "hrc-held", "hrc-awaited"];
 
 export interface Replay {
   labels: string[];
@@ -85,15 +86,36 @@ export default class TokenGameMode {
     this.eventBus.fire("tokenGame.stopped", {});
   }
 
-  /** What a click on a node does: fire the task's completion, its start, or the silent transition. */
+  /**
+   * What a click on a node does: fire the task's completion, its start, or the
+   * silent transition; a task a constraint holds back says why instead.
+   */
   fireTask(id: string): NetTransition | null {
     const game = this.game;
     const firing = game?.firingFor(id) ?? null;
+    if (game && !firing) this.explainHeldBack(game, id);
     if (!game || !firing) return null;
     game.fire(firing.id);
     this.replaying = null;
     this.render();
     return firing;
+  }
+
+  /** The task's name as drawn: its label in quotes, its id where it has none. */
+  nameOf(id: string): string {
+    const data = (objectOf(this.elementRegistry.get(id)) as { data?: { label?: string } } | undefined)?.data;
+    return quotedName(id, data?.label);
+  }
+
+  private explainHeldBack(game: TokenGame, task: string): void {
+    const words = heldBackWords(game, task, (id) => this.nameOf(id));
+    if (!words) return;
+    this.render();
+    for (const place of game.heldBack(task)) {
+      for (const other of place.of) if (other !== task && this.elementRegistry.get(other)) this.mark(other, "hrc-awaited");
+    }
+    this.mark(task, "hrc-held");
+    this.eventBus.fire("tokenGame.changed", { caption: words });
   }
 
   back(): void {
@@ -144,9 +166,14 @@ export default class TokenGameMode {
       return `Witness step ${done} of ${total}${last ? `: ${last.label}` : ""}. Next: ${game.future[0].label}.`;
     }
     const enabled = game.enabled();
-    const lastWords = last ? `Fired ${last.label}. ` : "";
-    if (enabled.length === 0) return `${lastWords}Nothing is enabled.`;
-    return `${lastWords}Enabled: ${enabled.map((t) => t.label).join(", ")}.`;
+    const lastWords = last ? `Fired: ${this.firingWords(last)}. ` : "";
+    if (enabled.length === 0) return `${lastWords}Nothing can fire.`;
+    return `${lastWords}Can fire: ${enabled.map((t) => this.firingWords(t)).join(", ")}.`;
+  }
+
+  /** A firing as the drawing says it: `start “Pick insert”`. */
+  firingWords(transition: NetTransition): string {
+    return transition.kind === "silent" ? this.nameOf(transition.task) : `${transition.kind} ${this.nameOf(transition.task)}`;
   }
 
   private render(): void {
