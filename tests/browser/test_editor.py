@@ -23,6 +23,7 @@ from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
+from tests.browser.conftest import assert_fits
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
@@ -252,6 +253,10 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     )
     version = PatternVersion.objects.get()
     assert version.number == 1
+    # The message leads to the version's page, by the id the publish API returned.
+    published = page.locator(".hrc-toolbar .hrc-status").get_by_role("link")
+    expect(published).to_have_text("Published version 1.")
+    expect(published).to_have_attribute("href", f"/patterns/versions/{version.pk}/")
     assert version.pattern.name == "Assembly (1 operator, 1 cobot)"
     _assert_is_the_thesis_assembly(version.document)
     screenshot(page, "editor-assembly-published")
@@ -504,6 +509,7 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
 def test_a_refused_edit_says_why_and_draws_nothing(
     page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
 ) -> None:
+    page.set_viewport_size({"width": 1280, "height": 800})
     pattern = _assembly(organisation)
     sign_in(page, engineer)
     _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
@@ -523,6 +529,12 @@ def test_a_refused_edit_says_why_and_draws_nothing(
     expect(arcs).to_have_count(count)
     expect(constraints).to_have_count(2)
     expect(page.get_by_role("button", name="Undo")).to_be_disabled()
+    # The refusal leaves the constraints legend readable.
+    refusal, legend = hint.bounding_box(), page.locator(".hrc-legend").bounding_box()
+    assert refusal is not None and legend is not None
+    assert refusal["x"] >= legend["x"] + legend["width"] or (
+        refusal["y"] + refusal["height"] <= legend["y"]
+    ), (refusal, legend)
 
 
 def test_an_outsider_gets_404_for_our_pattern(
@@ -739,3 +751,47 @@ def test_a_lane_moves_up_with_its_tasks_and_one_undo_puts_it_back(
     _until(lambda: _near(_box(page, "o"), operator))
     assert _near(_box(page, "c"), cobot)
     assert _near(_box(page, "to1"), operator_task)
+
+
+def test_a_constraint_shows_its_task_names_and_reverses_with_undo(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    page.set_viewport_size({"width": 1280, "height": 800})
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    expect(_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    # The first constraint of the example: to1 → tc2, drawn as a straight line between them.
+    (x1, y1), (x2, y2) = _centre(page, "to1"), _centre(page, "tc2")
+    page.mouse.click(x1 + (x2 - x1) / 2, y1 + (y2 - y1) / 2)
+    panel = page.get_by_role("region", name="Properties")
+    ends = panel.locator(".hrc-constraint-ends")
+    expect(ends).to_have_text("“prepare workpiece” → “place insert” (time)")
+    assert "to1" not in (ends.text_content() or "")
+    screenshot(page, "editor-constraint-panel-1280")
+    assert_fits(page)
+
+    panel.get_by_role("button", name="Reverse").click()
+    expect(ends).to_have_text("“place insert” → “prepare workpiece” (time)")
+    _save_and_expect_constraints(page, pattern, {("tc2", "to1"), ("tc3", "to2")})
+
+    page.get_by_role("button", name="Undo").click()
+    expect(ends).to_have_text("“prepare workpiece” → “place insert” (time)")
+    _save_and_expect_constraints(page, pattern, {("to1", "tc2"), ("tc3", "to2")})
+
+
+def _save_and_expect_constraints(
+    page: Page, pattern: PatternModel, expected: set[tuple[str, str]]
+) -> None:
+    page.get_by_role("button", name="Save").click()
+
+    def saved() -> bool:
+        pattern.refresh_from_db()
+        return {(c["from"], c["to"]) for c in pattern.draft["constraints"]} == expected
+
+    _until(saved)

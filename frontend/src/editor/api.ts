@@ -69,7 +69,7 @@ export class Api {
     return this.request("PATCH", `/patterns/${id}/`, { name, draft });
   }
 
-  publish(id: number): Promise<{ number: number }> {
+  publish(id: number): Promise<{ id: number; number: number }> {
     return this.request("POST", `/patterns/${id}/publish/`);
   }
 
