@@ -2,6 +2,7 @@
 and where the drawing puts them. No database."""
 
 import datetime as dt
+import itertools
 
 import pytest
 
@@ -12,7 +13,9 @@ from hrc.analytics.gantt import (
     ConstraintRow,
     build_gantt,
     draw_gantt,
+    format_duration,
     format_offset,
+    time_axis,
 )
 from hrc.analytics.metrics import InterruptionRow, ItemRow
 
@@ -194,4 +197,67 @@ def test_offsets_read_as_minutes_and_seconds_then_hours() -> None:
         "59:59",
         "1:00:00",
         "2:02:05",
+    ]
+
+
+def _one_long_bar() -> list[ItemRow]:
+    """Three short tasks around one that takes an hour."""
+    return [
+        item(1, "to1", "o", 0, 2, 8),
+        item(2, "tc1", "c", 8, 10, 3610),
+        item(3, "to2", "o", 3610, 3612, 3618),
+        item(4, "tc2", "c", 3618, 3619, 3625),
+    ]
+
+
+def test_one_long_bar_no_longer_squeezes_the_short_ones_to_a_sliver() -> None:
+    gantt = build_gantt(
+        1, started_at=at(0), ended_at=at(3625), now=at(4000), actors=ACTORS,
+        items=_one_long_bar(), constraints=[], interruptions=[],
+    )  # fmt: skip
+    drawing = draw_gantt(gantt, width=1100)
+    bars = {b.bar.task: b for b in drawing.bars}
+    linear = (1100 - RIGHT_MARGIN - LABEL_WIDTH) / 3625  # px per second without the break
+    assert 6 * linear < 2  # a sliver: why the axis breaks
+    assert bars["to1"].width > 60
+    assert bars["to2"].width > 60
+    assert bars["tc1"].width > bars["to1"].width  # the long bar stays the longest
+    assert bars["tc1"].seconds_worked == 3600  # and its tooltip keeps the real time
+    (broken,) = drawing.breaks
+    assert broken.hidden == 3600
+    assert broken.label == "1 h 00 min"
+    assert bars["tc1"].x < broken.x < bars["tc1"].x + bars["tc1"].width
+    # Time still runs left to right, and the last bar ends at the right margin.
+    xs = [bars[t].x for t in ("to1", "tc1", "to2", "tc2")]
+    assert xs == sorted(xs)
+    assert bars["tc2"].x + bars["tc2"].width == pytest.approx(1100 - RIGHT_MARGIN)
+    # The axis reads the jump: a tick where the time after the break begins.
+    assert "1:00:10" in [t.label for t in drawing.ticks]
+    gaps = [b.x - a.x for a, b in itertools.pairwise(drawing.ticks)]
+    assert min(gaps) >= 48
+
+
+def test_an_axis_without_long_stretches_is_one_linear_piece() -> None:
+    axis = time_axis([0, 10, 30, 40, 60, 90], 100)
+    (piece,) = axis.pieces
+    assert (piece.start, piece.end, piece.shown_start, piece.shown_end) == (0, 100, 0, 100)
+    assert axis.shown(25) == 25
+    assert axis.breaks == []
+
+
+def test_a_long_idle_stretch_is_shortened_to_four_typical_ones() -> None:
+    axis = time_axis([0, 5, 10, 15, 1015, 1020], 1020)
+    (broken,) = axis.breaks
+    assert (broken.start, broken.end) == (15, 1015)
+    assert broken.shown_end - broken.shown_start == 20  # 4 x the median stretch (5 s), >= 10 s
+    assert axis.shown(1020) == 15 + 20 + 5
+    assert axis.shown(515) == pytest.approx(15 + 10)  # halfway through, halfway along
+
+
+def test_durations_read_in_seconds_minutes_then_hours() -> None:
+    assert [format_duration(s) for s in (45, 300, 3600, 3900)] == [
+        "45 s",
+        "5 min",
+        "1 h 00 min",
+        "1 h 05 min",
     ]
