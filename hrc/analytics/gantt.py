@@ -238,9 +238,11 @@ def _mark(row: InterruptionRow) -> Mark:
 # The time axis ---------------------------------------------------------------------------
 
 # A stretch between two consecutive events longer than BREAK_RATIO times the median stretch
-# (and than MIN_BREAK seconds) is drawn as if it lasted that long, with a break marker.
+# (and than MIN_BREAK seconds) is drawn as if it lasted that long, with a break marker;
+# but only where the median stretch would be drawn under READABLE_SHARE of the axis.
 BREAK_RATIO = 4.0
 MIN_BREAK = 10.0
+READABLE_SHARE = 1 / 40
 
 
 @dataclass(frozen=True)
@@ -280,13 +282,14 @@ class TimeAxis:
 
 def time_axis(offsets: Iterable[float], span: float) -> TimeAxis:
     """The axis over [0, span] seconds with a piece between each two consecutive event
-    offsets; unbroken neighbours are merged, so a case without long stretches has one
-    linear piece."""
+    offsets; unbroken neighbours are merged, so a case whose typical stretch reads well on
+    a linear axis has one linear piece."""
     moments = sorted({0.0, span, *(min(max(o, 0.0), span) for o in offsets)})
     gaps = [(a, b) for a, b in itertools.pairwise(moments) if b > a]
-    if not gaps:
+    typical = statistics.median(b - a for a, b in gaps) if gaps else span
+    if typical >= READABLE_SHARE * span:
         return TimeAxis((AxisPiece(0.0, span, 0.0, span, False),))
-    limit = max(BREAK_RATIO * statistics.median(b - a for a, b in gaps), MIN_BREAK)
+    limit = max(BREAK_RATIO * typical, MIN_BREAK)
     pieces: list[AxisPiece] = []
     shown = 0.0
     for a, b in gaps:
