@@ -795,3 +795,38 @@ def _save_and_expect_constraints(
         return {(c["from"], c["to"]) for c in pattern.draft["constraints"]} == expected
 
     _until(saved)
+
+
+def test_lanes_come_by_dragging_and_appended_branches_stay_in_their_lane(
+    page: Page, live_url: str, engineer: User, sign_in: SignIn
+) -> None:
+    sign_in(page, engineer)
+    _open(page, f"{live_url}/patterns/new/")
+    canvas = page.locator(".hrc-canvas").bounding_box()
+    assert canvas is not None
+    # Dragged from the palette and let go over the canvas, a lane tool adds its lane.
+    for tool in ("Cobot lane", "Operator lane"):
+        entry = page.get_by_role("button", name=tool, exact=True).bounding_box()
+        assert entry is not None
+        page.mouse.move(entry["x"] + entry["width"] / 2, entry["y"] + entry["height"] / 2)
+        page.mouse.down()
+        page.mouse.move(canvas["x"] + canvas["width"] / 2, canvas["y"] + 150, steps=10)
+        page.mouse.up()
+    expect(page.locator('.djs-element[data-element-id="c"]')).to_have_count(1)
+    expect(page.locator('.djs-element[data-element-id="o"]')).to_have_count(1)
+
+    # Three branches after one place in the cobot's lane: all three stay inside it.
+    cobot = _box(page, "c")
+    _drop(page, "Place", cobot["x"] + 100, cobot["y"] + 30)
+    first = page.get_by_role("region", name="Properties").get_by_label("Id").input_value()
+    for _ in range(3):
+        _select(page, first)
+        _append(page)
+        page.keyboard.press("Escape")
+    lane = _box(page, "c")
+    tasks = page.locator('.djs-element[data-element-id^="tc"] .djs-hit')
+    expect(tasks).to_have_count(3)
+    for n in range(3):
+        box = tasks.nth(n).bounding_box()
+        assert box is not None
+        assert lane["y"] <= box["y"] and box["y"] + box["height"] <= lane["y"] + lane["height"]
