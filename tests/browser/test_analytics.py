@@ -17,9 +17,9 @@ from hrc.cases.models import Case, WorkItem
 from hrc.organisations.models import Organisation
 from hrc.patterns import services as pattern_services
 from tests import factories
-from tests.browser.conftest import assert_fits
 from tests.analytics.running import pin, pin_interruption, run_hand_over, run_shared_space
 from tests.analytics.xes_structure import NS, check_xes
+from tests.browser.conftest import assert_fits
 from tests.cases.patterns import shared_space
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -190,7 +190,9 @@ def test_a_long_bar_breaks_the_axis_and_the_short_bars_stay_readable(
     short = chart.locator('g.bar[data-task="to1"] rect.work').bounding_box()
     long = chart.locator('g.bar[data-task="tc1"] rect.work').bounding_box()
     marker = gap.locator("rect").bounding_box()
-    assert short is not None and long is not None and marker is not None
+    assert short is not None
+    assert long is not None
+    assert marker is not None
     assert short["width"] > 40  # 12 s of 3660: under 3 px on a linear axis
     assert long["width"] > short["width"]
     assert long["x"] < marker["x"] < long["x"] + long["width"]  # the break cuts the long bar

@@ -488,7 +488,9 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
         "“place insert” cannot start yet, held back by the time constraint "
         "“prepare workpiece” → “place insert”: it waits for o's “prepare workpiece” to complete."
     )
-    expect(page.locator('.djs-element[data-element-id="to1"]')).to_have_class(re.compile("hrc-awaited"))
+    expect(page.locator('.djs-element[data-element-id="to1"]')).to_have_class(
+        re.compile("hrc-awaited")
+    )
     screenshot(page, "editor-token-game")
 
     # Back and forward are undo and redo of firings.
@@ -531,7 +533,8 @@ def test_a_refused_edit_says_why_and_draws_nothing(
     expect(page.get_by_role("button", name="Undo")).to_be_disabled()
     # The refusal leaves the constraints legend readable.
     refusal, legend = hint.bounding_box(), page.locator(".hrc-legend").bounding_box()
-    assert refusal is not None and legend is not None
+    assert refusal is not None
+    assert legend is not None
     assert refusal["x"] >= legend["x"] + legend["width"] or (
         refusal["y"] + refusal["height"] <= legend["y"]
     ), (refusal, legend)
@@ -829,4 +832,5 @@ def test_lanes_come_by_dragging_and_appended_branches_stay_in_their_lane(
     for n in range(3):
         box = tasks.nth(n).bounding_box()
         assert box is not None
-        assert lane["y"] <= box["y"] and box["y"] + box["height"] <= lane["y"] + lane["height"]
+        assert lane["y"] <= box["y"]
+        assert box["y"] + box["height"] <= lane["y"] + lane["height"]
