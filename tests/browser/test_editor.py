@@ -225,8 +225,9 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     for task in ("tc2", "to1"):
         expect(page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')).to_be_visible()
     deadlock = page.locator(".hrc-issue", has_text="can get stuck")
+    # The firings in the drawing's words: tc1 is "pick insert".
     expect(deadlock.locator(".hrc-witness-steps li")).to_have_text(
-        ["t1", "start tc1", "complete tc1"]
+        ["t1", "start “pick insert”", "complete “pick insert”"]
     )
     deadlock.get_by_role("button", name="Play the witness").click()
     bar = page.get_by_role("toolbar", name="Token game")

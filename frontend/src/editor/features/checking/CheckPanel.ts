@@ -90,7 +90,11 @@ export default class CheckPanel {
       const play = button("Play the witness", item);
       play.classList.add("hrc-play-witness");
       const steps = element("ol", "hrc-witness-steps", item);
-      for (const label of issue.witness) element("li", "", steps).textContent = label;
+      for (const label of issue.witness) {
+        const step = element("li", "", steps);
+        step.textContent = this.tokenGame.stepWords(label);
+        step.dataset.firing = label;
+      }
       play.addEventListener("click", () => void this.tokenGame.replay(issue.witness as string[], issue.elements));
     }
     return item;

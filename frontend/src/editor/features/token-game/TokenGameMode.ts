@@ -15,7 +15,7 @@ import type { Connection, Shape } from "diagram-js/lib/model/Types";
 import type { Api } from "../../api";
 import { heldBackWords, type NetTransition, readExecutionNet, TokenGame } from "../../model/net";
 import { isConstraint, isNode, objectOf } from "../../core/elements";
-import { quotedName } from "../../model/words";
+import { listOfNames, quotedName } from "../../model/words";
 import type PatternImporter from "../../core/PatternImporter";
 
 const OVERLAY = "hrc-game";
@@ -161,14 +161,22 @@ export default class TokenGameMode {
       const done = game.history.length;
       const total = done + game.future.length;
       if (game.future.length === 0) {
-        return `Witness replayed (${done} of ${total}): ${this.replaying.labels.join(", ") || "from the start"}. Nothing more can happen for ${this.replaying.elements.join(", ")}.`;
+        const steps = this.replaying.labels.map((label) => this.stepWords(label)).join(", ");
+        return `Witness replayed (${done} of ${total}): ${steps || "from the start"}. Nothing more can happen for ${listOfNames(this.replaying.elements, (id) => this.nameOf(id), 6)}.`;
       }
-      return `Witness step ${done} of ${total}${last ? `: ${last.label}` : ""}. Next: ${game.future[0].label}.`;
+      return `Witness step ${done} of ${total}${last ? `: ${this.firingWords(last)}` : ""}. Next: ${this.firingWords(game.future[0])}.`;
     }
     const enabled = game.enabled();
     const lastWords = last ? `Fired: ${this.firingWords(last)}. ` : "";
     if (enabled.length === 0) return `${lastWords}Nothing can fire.`;
     return `${lastWords}Can fire: ${enabled.map((t) => this.firingWords(t)).join(", ")}.`;
+  }
+
+  /** A witness step (`start tc1`, `t1`) as the drawing says it: `start “Pick insert”`. */
+  stepWords(label: string): string {
+    const [kind, ...rest] = label.split(" ");
+    if ((kind === "start" || kind === "complete") && rest.length) return `${kind} ${this.nameOf(rest.join(" "))}`;
+    return this.nameOf(label);
   }
 
   /** A firing as the drawing says it: `start “Pick insert”`. */
