@@ -9,12 +9,18 @@ A bar has two parts: waiting (offered until started) and working (started
 until ended, or until now while it runs). Bars of one actor that overlap in
 time (two operators mapped to one actor, parallel branches) get separate lanes
 of the row, so none hides another.
+
+The time axis is broken where a stretch between two events (a long bar, a long
+idle wait) lasts far longer than the case's typical one: that stretch is drawn
+shortened, with a break marker saying how long it really was, so one long bar
+does not squeeze every other bar to a sliver (`time_axis`).
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import itertools
+import math
 import statistics
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
@@ -229,6 +235,85 @@ def _mark(row: InterruptionRow) -> Mark:
     )  # fmt: skip
 
 
+# The time axis ---------------------------------------------------------------------------
+
+# A stretch between two consecutive events longer than BREAK_RATIO times the median stretch
+# (and than MIN_BREAK seconds) is drawn as if it lasted that long, with a break marker;
+# but only where the median stretch would be drawn under READABLE_SHARE of the axis.
+BREAK_RATIO = 4.0
+MIN_BREAK = 10.0
+READABLE_SHARE = 1 / 40
+
+
+@dataclass(frozen=True)
+class AxisPiece:
+    """A stretch of the case, in seconds since it started, and where it is drawn (`shown_*`)."""
+
+    start: float
+    end: float
+    shown_start: float
+    shown_end: float
+    broken: bool
+    """Drawn shorter than it lasted: a break marker goes in its middle."""
+
+
+@dataclass(frozen=True)
+class TimeAxis:
+    pieces: tuple[AxisPiece, ...]
+
+    @property
+    def shown_span(self) -> float:
+        return self.pieces[-1].shown_end if self.pieces else 0.0
+
+    def shown(self, offset: float) -> float:
+        """Where `offset` seconds since the start is drawn, in shown seconds; clamped to the axis."""
+        for piece in self.pieces:
+            if offset <= piece.end:
+                if offset <= piece.start:
+                    return piece.shown_start
+                part = (offset - piece.start) / (piece.end - piece.start)
+                return piece.shown_start + part * (piece.shown_end - piece.shown_start)
+        return self.shown_span
+
+    @property
+    def breaks(self) -> list[AxisPiece]:
+        return [piece for piece in self.pieces if piece.broken]
+
+
+def time_axis(offsets: Iterable[float], span: float) -> TimeAxis:
+    """The axis over [0, span] seconds with a piece between each two consecutive event
+    offsets; unbroken neighbours are merged, so a case whose typical stretch reads well on
+    a linear axis has one linear piece."""
+    moments = sorted({0.0, span, *(min(max(o, 0.0), span) for o in offsets)})
+    gaps = [(a, b) for a, b in itertools.pairwise(moments) if b > a]
+    typical = statistics.median(b - a for a, b in gaps) if gaps else span
+    if typical >= READABLE_SHARE * span:
+        return TimeAxis((AxisPiece(0.0, span, 0.0, span, False),))
+    limit = max(BREAK_RATIO * typical, MIN_BREAK)
+    pieces: list[AxisPiece] = []
+    shown = 0.0
+    for a, b in gaps:
+        broken = b - a > limit
+        length = limit if broken else b - a
+        last = pieces[-1] if pieces else None
+        if last is not None and not broken and not last.broken:
+            pieces[-1] = AxisPiece(last.start, b, last.shown_start, shown + length, False)
+        else:
+            pieces.append(AxisPiece(a, b, shown, shown + length, broken))
+        shown += length
+    return TimeAxis(tuple(pieces))
+
+
+def _event_offsets(gantt: Gantt) -> list[float]:
+    moments: list[dt.datetime | None] = [gantt.now if gantt.open else None]
+    for row in gantt.rows:
+        for bar in row.bars:
+            moments += [bar.offered_at, bar.started_at, bar.until(gantt.now)]
+    for mark in gantt.marks:
+        moments += [mark.started_at, mark.ended_at]
+    return [seconds(gantt.start, m) for m in moments if m is not None]
+
+
 # Drawing ---------------------------------------------------------------------------------
 
 LABEL_WIDTH = 170  # the actors' names left of the chart
@@ -242,12 +327,6 @@ CHAR_WIDTH = 6.6  # an estimate for 12 px system-ui, to decide whether a label f
 # Tick spacings in seconds: the smallest that gives at most MAX_TICKS ticks is used.
 TICK_STEPS = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 14400, 28800, 86400)
 MAX_TICKS = 10
-MIN_TICK_GAP = 44  # pixels between two tick labels
-# A stretch of time in which nothing starts or ends is drawn shorter when it is longer than
-# BREAK_FACTOR times the median stretch (and than MIN_BREAK_SECONDS): one long step or wait then
-# no longer squeezes every other bar to a sliver. The axis shows the break and what it left out.
-BREAK_FACTOR = 4.0
-MIN_BREAK_SECONDS = 5.0
 
 
 @dataclass(frozen=True)
@@ -323,69 +402,27 @@ class Tick:
 
 
 @dataclass(frozen=True)
-class AxisBreak:
-    """Where the axis is broken: the x of the break and the seconds it leaves out."""
+class DrawnBreak:
+    """Where the axis leaves out time: `x` is the marker's middle, `width` the shortened stretch."""
 
     x: float
-    seconds: float
-
-
-@dataclass(frozen=True)
-class TimeAxis:
-    """Time to x, piecewise: each stretch between two moments at its length, a long empty one
-    shortened to the cap (a broken axis)."""
-
-    left: float
-    scale: float
-    stretches: tuple[tuple[float, float, float], ...]
-    """(from, to, shown): real seconds since the start, and the seconds it is drawn as."""
-
-    @classmethod
-    def over(cls, span: float, moments: Iterable[float], left: float, right: float) -> TimeAxis:
-        cuts = sorted({0.0, span, *(min(max(m, 0.0), span) for m in moments)})
-        gaps = [b - a for a, b in itertools.pairwise(cuts) if b > a]
-        cap = max(BREAK_FACTOR * statistics.median(gaps), MIN_BREAK_SECONDS) if gaps else span
-        stretches = tuple(
-            (a, b, b - a if b - a <= cap else cap) for a, b in itertools.pairwise(cuts) if b > a
-        )
-        shown = sum(stretch[2] for stretch in stretches) or 1.0
-        return cls(left, (right - left) / shown, stretches)
-
-    def x(self, offset: float) -> float:
-        """Where `offset` seconds after the start are drawn."""
-        x = self.left
-        for start, end, shown in self.stretches:
-            if offset >= end:
-                x += shown * self.scale
-                continue
-            if offset > start:
-                x += (offset - start) / (end - start) * shown * self.scale
-            break
-        return x
+    width: float
+    hidden: float
+    """Seconds the shortened stretch really lasted."""
 
     @property
-    def breaks(self) -> list[AxisBreak]:
-        return [
-            AxisBreak(self.x((start + end) / 2), end - start - shown)
-            for start, end, shown in self.stretches
-            if end - start > shown
-        ]
+    def label(self) -> str:
+        return format_duration(self.hidden)
 
-    def ticks(self, span: float) -> list[Tick]:
-        """Ticks at round offsets, none inside a break, none crowding the one before."""
-        shown = sum(stretch[2] for stretch in self.stretches)
-        step = next((s for s in TICK_STEPS if shown / s <= MAX_TICKS), TICK_STEPS[-1])
-        broken = [(a, b) for a, b, drawn in self.stretches if b - a > drawn]
-        ticks: list[Tick] = []
-        for n in range(int(span // step) + 1):
-            offset = n * step
-            if any(a < offset < b for a, b in broken):
-                continue
-            x = self.x(offset)
-            if ticks and x - ticks[-1].x < MIN_TICK_GAP:
-                continue
-            ticks.append(Tick(x, format_offset(offset)))
-        return ticks
+    @property
+    def left(self) -> float:
+        return self.x - 4
+
+    @property
+    def marker(self) -> str:
+        """Two slashes across the axis line, the usual sign of a broken axis."""
+        y = TOP - 2
+        return f"M {self.x - 7:.1f} {y:.1f} l 6 -8 M {self.x + 1:.1f} {y:.1f} l 6 -8"
 
 
 @dataclass(frozen=True)
@@ -403,7 +440,7 @@ class GanttDrawing:
     ticks: list[Tick]
     now_x: float | None
     """Where now is, while the case is open."""
-    breaks: list[AxisBreak]
+    breaks: list[DrawnBreak]
 
     @property
     def tick_y(self) -> float:
@@ -418,10 +455,11 @@ def draw_gantt(gantt: Gantt, width: float = 1100) -> GanttDrawing:
     """The chart laid out `width` pixels wide, time running left to right."""
     right = width - RIGHT_MARGIN
     span = max(seconds(gantt.start, gantt.end), 1.0)
-    axis = TimeAxis.over(span, _moments(gantt), LABEL_WIDTH, right)
+    axis = time_axis(_event_offsets(gantt), span)
+    scale = (right - LABEL_WIDTH) / axis.shown_span
 
     def x_of(moment: dt.datetime) -> float:
-        return axis.x(seconds(gantt.start, moment))
+        return LABEL_WIDTH + axis.shown(seconds(gantt.start, moment)) * scale
 
     rows, bars, y = [], {}, float(TOP)
     for index, row in enumerate(gantt.rows):
@@ -471,25 +509,21 @@ def draw_gantt(gantt: Gantt, width: float = 1100) -> GanttDrawing:
         bars=list(bars.values()),
         arrows=arrows,
         marks=marks,
-        ticks=axis.ticks(span),
+        ticks=_ticks(
+            axis,
+            scale,
+            [LABEL_WIDTH + (p.shown_start + p.shown_end) / 2 * scale for p in axis.breaks],
+        ),
         now_x=x_of(gantt.now) if gantt.open else None,
-        breaks=axis.breaks,
+        breaks=[
+            DrawnBreak(
+                LABEL_WIDTH + (p.shown_start + p.shown_end) / 2 * scale,
+                (p.shown_end - p.shown_start) * scale,
+                p.end - p.start,
+            )
+            for p in axis.breaks
+        ],
     )
-
-
-def _moments(gantt: Gantt) -> list[float]:
-    """Every offset at which something starts or ends on the chart."""
-    moments = []
-    for row in gantt.rows:
-        for bar in row.bars:
-            for moment in (bar.offered_at, bar.started_at, bar.until(gantt.now)):
-                if moment is not None:
-                    moments.append(seconds(gantt.start, moment))
-    for mark in gantt.marks:
-        moments += [seconds(gantt.start, m) for m in (mark.started_at, mark.ended_at) if m]
-    if gantt.open:
-        moments.append(seconds(gantt.start, gantt.now))
-    return moments
 
 
 def _drawn_bar(bar: Bar, y: float, x_of: _XOf, now: dt.datetime) -> DrawnBar:
@@ -526,6 +560,46 @@ def _arrow_path(source: DrawnBar, target: DrawnBar, x1: float, x2: float) -> str
         return f"M {x1:.1f} {source.middle:.1f} H {x2:.1f} V {into:.1f}"
     out = source.y + BAR_HEIGHT if down else source.y
     return f"M {x1:.1f} {out:.1f} V {into:.1f}"
+
+
+MIN_TICK_GAP = 48  # pixels between two tick labels
+
+
+def _ticks(axis: TimeAxis, scale: float, breaks: list[float]) -> list[Tick]:
+    """Ticks at round offsets inside the unbroken pieces, and one where each piece after a
+    break begins, so the jump reads on the axis; none closer than MIN_TICK_GAP to the last
+    or to a break's label (at `breaks`)."""
+    shown = axis.shown_span
+    step = next((s for s in TICK_STEPS if shown / s <= MAX_TICKS), TICK_STEPS[-1])
+    ticks: list[Tick] = []
+    after_break = False
+    for piece in axis.pieces:
+        if piece.broken:
+            after_break = True
+            continue
+        offsets = [piece.start] if after_break else []
+        first = math.ceil(piece.start / step - 1e-9)
+        offsets += [n * step for n in range(first, int(piece.end // step + 1e-9) + 1)]
+        after_break = False
+        for offset in offsets:
+            x = LABEL_WIDTH + axis.shown(offset) * scale
+            if ticks and x - ticks[-1].x < MIN_TICK_GAP:
+                continue
+            if any(abs(x - b) < 1.5 * MIN_TICK_GAP for b in breaks):
+                continue
+            ticks.append(Tick(x, format_offset(offset)))
+    return ticks
+
+
+def format_duration(total: float) -> str:
+    """A duration in words short enough for an axis: 45 s, 12 min, 1 h 05 min."""
+    whole = round(total)
+    if whole < 90:
+        return f"{whole} s"
+    minutes = round(whole / 60)
+    if minutes < 60:
+        return f"{minutes} min"
+    return f"{minutes // 60} h {minutes % 60:02d} min"
 
 
 def format_offset(total: float) -> str:

@@ -16,6 +16,7 @@ from hrc.engine.model import Pattern
 from hrc.engine.petri import Marking, Net, NetTransition
 from hrc.engine.rules import STRUCTURAL_CODES, check_rules
 from hrc.engine.taskconfig import config_issues
+from hrc.engine.wording import Names, sentence
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,7 @@ class _Explainer:
         self.net = net
         self.transition = {t.id: t for t in net.transitions}
         self.constraint_of = constraint_places(pattern)
+        self.names = Names(pattern)
 
     def fault(self, fault: Fault) -> Issue:
         sequence = self.sequence(fault.witness)
@@ -98,8 +100,8 @@ class _Explainer:
         if fault.kind == "deadlock":
             waits = self.waits(marking)
             message = (
-                f"The model can deadlock: {sequence}, nothing more can happen and the case has "
-                f"not finished. {'; '.join(w for w, _ in waits) or 'Nothing is waiting.'}"
+                f"The pattern can get stuck: {sequence}, nothing more can happen and the case "
+                f"has not finished (a deadlock). {sentence('; '.join(w for w, _ in waits)) or 'Nothing is waiting.'}"
             )
             elements = [e for _, ends in waits for e in ends]
         elif fault.kind == "improper":
@@ -107,9 +109,9 @@ class _Explainer:
                 p for p in marking if p not in self.net.final and p not in self.net.ignored
             )
             message = (
-                f"The case can end with work left over: {sequence}, the end place is marked "
+                f"The case can end with work left over: {sequence}, the end place has its token "
                 f"while {', '.join(self.place_words(p) for p in left)} still "
-                f"{'holds a token' if len(left) == 1 else 'hold tokens'}."
+                f"{'holds one' if len(left) == 1 else 'hold tokens'}."
             )
             elements = [self.task_of(p) for p in left]
         elif fault.kind == "livelock":
@@ -119,10 +121,10 @@ class _Explainer:
             )
             elements = sorted({self.transition[f].task for f in fault.witness[-3:]})
         else:
-            repeat = ", ".join(self.transition[f].label for f in fault.repeat)
+            repeat = ", ".join(self.step(f) for f in fault.repeat)
             place = fault.place or "?"
             message = (
-                f"{self.place_words(place).capitalize()} can collect tokens without limit: "
+                f"{sentence(self.place_words(place))} can collect tokens without limit: "
                 f"{sequence}, repeating {repeat} adds tokens there each time."
             )
             issue = error("unbounded", message, self.task_of(place))
@@ -151,25 +153,21 @@ class _Explainer:
                 never_complete.append(transition)
         parts = []
         if never_start:
-            parts.append(f"{_tasks(never_start)} can never start")
+            parts.append(f"{self.tasks(never_start)} can never start")
         if never_complete:
-            parts.append(f"{_tasks(never_complete)} can start but never complete")
+            parts.append(f"{self.tasks(never_complete)} can start but never complete")
         if never_fire:
-            names = ", ".join(t.task for t in never_fire)
-            parts.append(
-                f"transition {names} never fires"
-                if len(never_fire) == 1
-                else f"transitions {names} never fire"
-            )
-        message = f"{'; '.join(parts)} in any run of the model."
+            names = self.names.nodes([t.task for t in never_fire])
+            parts.append(f"{names} never {'fires' if len(never_fire) == 1 else 'fire'}")
+        message = f"{'; '.join(parts)} in any run of the pattern."
         needs = [
-            f"{t.label} needs {self.constraint_of[p].needed()}"
+            f"{self.waiting(t)} needs {self.constraint_of[p].needed(self.names.name)}"
             for t in never_start + never_complete
             for p, _ in t.pre
             if p in self.constraint_of
         ]
         if needs:
-            message += " " + "; ".join(needs) + "."
+            message += " " + sentence("; ".join(needs)) + "."
         elements = [t.task for t in never_start + never_complete + never_fire]
         return error("unsound", message[0].upper() + message[1:], *elements)
 
@@ -188,7 +186,7 @@ class _Explainer:
             needs = " and ".join(self.needed(p) for p in missing)
             ends = [transition.task]
             ends += [self.constraint_of[p].first for p in missing if p in self.constraint_of]
-            wait = (f"{transition.label} waits for {needs}", ends)
+            wait = (f"{self.waiting(transition)} waits for {needs}", ends)
             if all(p in self.constraint_of for p in missing):
                 held_by_constraint.append(wait)
             else:
@@ -197,15 +195,31 @@ class _Explainer:
 
     def needed(self, place: str) -> str:
         if place in self.constraint_of:
-            return self.constraint_of[place].needed()
+            return self.constraint_of[place].needed(self.names.name)
         if place.startswith("running:"):
-            return f"{place.split(':', 1)[1]} to be running"
-        return f"a token in {place}"
+            return f"{self.names.task(place.split(':', 1)[1])} to be running"
+        return f"a token in {self.names.place(place)}"
 
     def place_words(self, place: str) -> str:
         if place.startswith("running:"):
-            return f"the running task {place.split(':', 1)[1]}"
-        return f"place {place}"
+            return f"the running {self.names.task(place.split(':', 1)[1])}"
+        return self.names.place(place)
+
+    def step(self, firing: str) -> str:
+        """A firing in words: `“pick insert” starts`."""
+        transition = self.transition[firing]
+        return self.names.firing(transition.kind, transition.task)
+
+    def waiting(self, transition: NetTransition) -> str:
+        """Who waits: `the start of “pick insert”`, `the completion of …`, `split/join t1`."""
+        if transition.kind == "start":
+            return f"the start of {self.names.task(transition.task)}"
+        if transition.kind == "complete":
+            return f"the completion of {self.names.task(transition.task)}"
+        return self.names.node(transition.task)
+
+    def tasks(self, transitions: list[NetTransition]) -> str:
+        return self.names.nodes([t.task for t in transitions])
 
     def task_of(self, place: str) -> str:
         return place.split(":", 1)[1] if place.startswith("running:") else place
@@ -216,9 +230,4 @@ class _Explainer:
     def sequence(self, firings: tuple[str, ...]) -> str:
         if not firings:
             return "right at the start"
-        return "after " + ", ".join(self.labels(firings))
-
-
-def _tasks(transitions: list[NetTransition]) -> str:
-    names = ", ".join(t.task for t in transitions)
-    return f"task {names}" if len(transitions) == 1 else f"tasks {names}"
+        return "after " + ", ".join(self.step(f) for f in firings)

@@ -18,6 +18,7 @@ structural): it assumes every arc, performer and constraint end exists.
 """
 
 from collections import defaultdict
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -59,15 +60,14 @@ class ConstraintPlace:
     producer: str
     consumer: str
 
-    def needed(self) -> str:
-        """What the consumer waits for, as a person says it."""
+    def needed(self, name: Callable[[str], str] = str) -> str:
+        """What the consumer waits for, as a person says it; `name` turns a task id into words."""
+        first, second = name(self.first), name(self.second)
         if self.kind == "time":
-            return f"a completion of {self.first} (time constraint {self.first} → {self.second})"
+            return f"a completion of {first} (time constraint {first} → {second})"
         if self.kind == "func-start":
-            return (
-                f"{self.first} to be running (func constraint: {self.first} supports {self.second})"
-            )
-        return f"{self.first} to complete (func constraint: {self.second} supports {self.first})"
+            return f"{first} to be running (func constraint: {first} supports {second})"
+        return f"{first} to complete (func constraint: {second} supports {first})"
 
 
 def constraint_places(pattern: Pattern) -> dict[str, ConstraintPlace]:

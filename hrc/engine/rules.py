@@ -11,42 +11,44 @@ from collections.abc import Iterable
 from hrc.engine.graph import reachable
 from hrc.engine.issues import STRUCTURAL_CODES, Issue, error
 from hrc.engine.model import CONSTRAINT_TYPES, Pattern, Process
+from hrc.engine.wording import Names, sentence
 
 __all__ = ["STRUCTURAL_CODES", "check_rules"]
 
 
 def check_rules(pattern: Pattern) -> list[Issue]:
     """Every broken structural rule of the 7-tuple, in the order of pattern-format.md."""
+    names = Names(pattern)
     return [
-        *_duplicate_ids(pattern),
-        *_arcs(pattern),
-        *_actors(pattern),
-        *_constraints(pattern),
-        *(issue for process in pattern.processes for issue in _workflow_net(process)),
+        *_duplicate_ids(pattern, names),
+        *_arcs(pattern, names),
+        *_actors(pattern, names),
+        *_constraints(pattern, names),
+        *(issue for process in pattern.processes for issue in _workflow_net(process, names)),
     ]
 
 
-def _duplicate_ids(pattern: Pattern) -> Iterable[Issue]:
+def _duplicate_ids(pattern: Pattern, names: Names) -> Iterable[Issue]:
     kinds: dict[str, list[str]] = defaultdict(list)
     for actor in pattern.actors:
-        kinds[actor.id].append("actor")
+        kinds[actor.id].append(f"the {actor.type}'s lane")
     for process in pattern.processes:
-        kinds[process.id].append("process")
+        kinds[process.id].append("a process")
         for place in process.places:
-            kinds[place.id].append(f"place of {process.id}")
+            kinds[place.id].append("a place")
         for transition in process.transitions:
-            kinds[transition.id].append(f"transition of {process.id}")
+            kinds[transition.id].append("a task" if transition.is_task else "a split/join")
     for element_id, uses in kinds.items():
         if len(uses) > 1:
             yield error(
                 "duplicate-id",
-                f"The id {element_id!r} is used {len(uses)} times ({', '.join(uses)}); "
-                "ids must be unique across the whole document: rename all but one.",
+                f"The id {element_id!r} is given to {len(uses)} elements ({', '.join(uses)}); "
+                "each element needs its own id: rename all but one in the properties panel.",
                 element_id,
             )
 
 
-def _arcs(pattern: Pattern) -> Iterable[Issue]:
+def _arcs(pattern: Pattern, names: Names) -> Iterable[Issue]:
     for process in pattern.processes:
         places = {p.id for p in process.places}
         transitions = {t.id for t in process.transitions}
@@ -54,28 +56,34 @@ def _arcs(pattern: Pattern) -> Iterable[Issue]:
             unknown = [end for end in (source, target) if end not in places | transitions]
             for end in unknown:
                 owner = pattern.process_of(end)
-                where = f"it belongs to process {owner.id}" if owner else "it does not exist"
+                where = f"it belongs to process {owner.id}" if owner else "no such element exists"
                 yield error(
                     "unknown-node",
-                    f"The arc {source} → {target} in process {process.id} names {end!r}, "
-                    f"but {where}: an arc joins nodes of its own net.",
+                    f"An arrow in {names.process(process.id)} leads "
+                    f"{'from' if end == source else 'to'} {end!r}, but {where}: an arrow joins "
+                    "elements of its own process. Delete the arrow and draw it again.",
                     source,
                     target,
                 )
             if unknown:
                 continue
             if (source in places) == (target in places):
-                kind = "places" if source in places else "transitions"
+                fix = (
+                    "put a task or a split/join between them"
+                    if source in places
+                    else "put a place between them"
+                )
                 yield error(
                     "arc-kind",
-                    f"The arc {source} → {target} joins two {kind}; an arc must join a place "
-                    "and a transition (put a transition or a place between them).",
+                    f"The arrow from {names.node(source)} to {names.node(target)} joins two "
+                    f"{'places' if source in places else 'tasks'}: an arrow goes from a place to "
+                    f"a task or from a task to a place, so {fix}.",
                     source,
                     target,
                 )
 
 
-def _actors(pattern: Pattern) -> Iterable[Issue]:
+def _actors(pattern: Pattern, names: Names) -> Iterable[Issue]:
     known = {actor.id for actor in pattern.actors}
     assigned: set[str] = set()
     for process in pattern.processes:
@@ -83,8 +91,8 @@ def _actors(pattern: Pattern) -> Iterable[Issue]:
             if actor_id not in known:
                 yield error(
                     "unknown-actor",
-                    f"Process {process.id} is assigned the actor {actor_id!r}, which is not "
-                    "declared under actors.",
+                    f"{sentence(names.process(process.id))} has a lane for {actor_id!r}, "
+                    "which is not one of the pattern's actors: add the actor or remove the lane.",
                     process.id,
                     actor_id,
                 )
@@ -93,12 +101,16 @@ def _actors(pattern: Pattern) -> Iterable[Issue]:
         for transition in process.transitions:
             performer = transition.performer
             if performer is not None and performer not in process.actors:
-                reason = "not assigned to" if performer in known else "not an actor of"
+                reason = (
+                    f"has no lane in {names.process(process.id)}"
+                    if performer in known
+                    else "is not one of the pattern's actors"
+                )
                 yield error(
                     "unknown-actor",
-                    f"Task {transition.id} is performed by {performer!r}, which is {reason} "
-                    f"process {process.id}: assign the actor to the process or pick another "
-                    "performer.",
+                    f"{sentence(names.task(transition.id))} is "
+                    f"performed by {performer!r}, which {reason}: move the task into an actor's "
+                    "lane or pick another performer.",
                     transition.id,
                     performer,
                 )
@@ -106,8 +118,8 @@ def _actors(pattern: Pattern) -> Iterable[Issue]:
             if actor_id in known and actor_id not in performing:
                 yield error(
                     "idle-actor",
-                    f"Actor {actor_id} is assigned to process {process.id} but performs none of "
-                    "its tasks: give it a task there or remove it from the process.",
+                    f"The lane of {names.actor(actor_id)} in {names.process(process.id)} has no "
+                    "task: draw a task in it or remove the lane.",
                     actor_id,
                     process.id,
                 )
@@ -115,20 +127,21 @@ def _actors(pattern: Pattern) -> Iterable[Issue]:
         if actor.id not in assigned:
             yield error(
                 "unassigned-actor",
-                f"Actor {actor.id} is assigned to no process: add it to a process' actors or "
-                "remove it.",
+                f"{sentence(names.actor(actor.id))} has no lane: add a lane for it or "
+                "remove the actor.",
                 actor.id,
             )
 
 
-def _constraints(pattern: Pattern) -> Iterable[Issue]:
+def _constraints(pattern: Pattern, names: Names) -> Iterable[Issue]:
     for constraint in pattern.constraints:
         a, b = constraint.source, constraint.target
-        name = f"The {constraint.type} constraint {a} → {b}"
+        pair = f"{names.name(a)} → {names.name(b)}"
+        name = f"The {constraint.type} constraint {pair}"
         if constraint.type not in CONSTRAINT_TYPES:
             yield error(
                 "constraint-type",
-                f"The constraint {a} → {b} has type {constraint.type!r}; the type must be one of "
+                f"The constraint {pair} has type {constraint.type!r}; the type must be one of "
                 f"{', '.join(CONSTRAINT_TYPES)}.",
                 a,
                 b,
@@ -136,10 +149,10 @@ def _constraints(pattern: Pattern) -> Iterable[Issue]:
         ends = [pattern.transition(a), pattern.transition(b)]
         missing = [end for end, found in zip((a, b), ends, strict=True) if found is None]
         for end in missing:
-            what = "a place" if pattern.process_of(end) else "no element"
+            what = names.place(end) if pattern.process_of(end) else "no element of the drawing"
             yield error(
                 "unknown-node",
-                f"{name} names {end!r}, which is {what}; a constraint joins two tasks.",
+                f"{name} ends at {end!r}, which is {what}: a constraint joins two tasks.",
                 a,
                 b,
             )
@@ -153,33 +166,45 @@ def _constraints(pattern: Pattern) -> Iterable[Issue]:
         if unperformed:
             yield error(
                 "constraint-unperformed",
-                f"{name} joins {' and '.join(unperformed)}, which no actor performs; "
-                "constraints join tasks of actors, not splits or joins.",
+                f"{name} ends at {names.nodes(unperformed)}, which no actor performs: "
+                "constraints join tasks in actors' lanes, not splits or joins.",
                 *unperformed,
             )
         elif task_a.performer == task_b.performer:
             yield error(
                 "constraint-same-performer",
-                f"{name} joins two tasks of the same performer ({task_a.performer}); "
-                "constraints relate tasks of different actors (order one actor's tasks with arcs).",
+                f"{name} joins two tasks of the same {names.actor(task_a.performer or '')}: "
+                "constraints relate tasks of different actors (order one actor's tasks with "
+                "arrows).",
                 a,
                 b,
             )
 
 
-def _workflow_net(process: Process) -> Iterable[Issue]:
+def _workflow_net(process: Process, names: Names) -> Iterable[Issue]:
     """A workflow net has one source place, one sink place, and every node on a path between."""
     sources, sinks = process.source_places(), process.sink_places()
     if len(sources) != 1 or len(sinks) != 1:
         parts = []
-        if len(sources) != 1:
-            parts.append(f"{len(sources)} source places ({_listed(sources)})")
-        if len(sinks) != 1:
-            parts.append(f"{len(sinks)} sink places ({_listed(sinks)})")
+        if not sources:
+            parts.append("no place where a case starts (every place has an arrow coming in)")
+        elif len(sources) > 1:
+            parts.append(
+                f"{len(sources)} places where a case could start ({names.nodes(sources)}: "
+                "no arrow comes into them)"
+            )
+        if not sinks:
+            parts.append("no place where a case ends (every place has an arrow going out)")
+        elif len(sinks) > 1:
+            parts.append(
+                f"{len(sinks)} places where a case could end ({names.nodes(sinks)}: "
+                "no arrow leaves them)"
+            )
         yield error(
             "not-workflow-net",
-            f"Process {process.id} has {' and '.join(parts)}; a workflow net has exactly one "
-            "place where a case starts (no incoming arc) and one where it ends (no outgoing arc).",
+            f"{sentence(names.process(process.id))} has {' and '.join(parts)}. It needs "
+            "exactly one place where a case starts and one where it ends: connect the loose "
+            "places with arrows or remove them.",
             process.id,
             *sources,
             *sinks,
@@ -200,16 +225,11 @@ def _workflow_net(process: Process) -> Iterable[Issue]:
     if stray:
         yield error(
             "not-workflow-net",
-            f"In process {process.id}, {_listed(stray)} "
-            f"{'lies' if len(stray) == 1 else 'lie'} on no path from {sources[0]} to {sinks[0]}: "
-            "connect them or remove them.",
+            f"In {names.process(process.id)}, {names.nodes(stray)} "
+            f"{'is' if len(stray) == 1 else 'are'} on no path from the start "
+            f"({names.place(sources[0])}) to the end ({names.place(sinks[0])}): connect "
+            f"{'it' if len(stray) == 1 else 'them'} with arrows or remove "
+            f"{'it' if len(stray) == 1 else 'them'}.",
             process.id,
             *stray,
         )
-
-
-def _listed(ids: list[str], limit: int = 8) -> str:
-    if not ids:
-        return "none"
-    shown = ", ".join(ids[:limit])
-    return shown if len(ids) <= limit else f"{shown} and {len(ids) - limit} more"

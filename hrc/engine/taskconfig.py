@@ -36,6 +36,7 @@ from typing import Any, Final, Literal
 from hrc.engine import expressions
 from hrc.engine.issues import Issue, error
 from hrc.engine.model import Actor, Pattern, Transition
+from hrc.engine.wording import Names, sentence
 
 TaskKind = Literal["operator", "step", "device"]
 
@@ -110,6 +111,7 @@ class ConfigError(ValueError):
     def __init__(self, transition: str, message: str) -> None:
         super().__init__(f"{transition}: {message}")
         self.transition = transition
+        self.problem = message
 
 
 def task_config(pattern: Pattern, transition: Transition) -> TaskConfig:
@@ -292,6 +294,7 @@ def initial_data(pattern: Pattern) -> dict[str, Any]:
 def config_issues(pattern: Pattern) -> list[Issue]:
     """Every malformed task, guard or message configuration, as `task-config` errors."""
     issues = []
+    names = Names(pattern)
     try:
         initial_data(pattern)
     except ConfigError as problem:
@@ -313,14 +316,16 @@ def config_issues(pattern: Pattern) -> list[Issue]:
                         "put the guard on a silent transition after it.",
                     )
         except ConfigError as problem:
-            issues.append(error("task-config", str(problem), transition.id))
+            where = sentence(names.node(transition.id))
+            issues.append(error("task-config", f"{where}: {problem.problem}", transition.id))
     for constraint in pattern.constraints:
         mode = constraint.extra.get("interrupt", "pause")
         if constraint.type == "space" and mode not in INTERRUPT_MODES:
             issues.append(
                 error(
                     "task-config",
-                    f"The space constraint {constraint.source} → {constraint.target} has "
+                    f"The space constraint {names.name(constraint.source)} → "
+                    f"{names.name(constraint.target)} has "
                     f"interrupt {mode!r}; it must be one of {', '.join(INTERRUPT_MODES)}.",
                     constraint.source,
                     constraint.target,

@@ -2,6 +2,7 @@
 and where the drawing puts them. No database."""
 
 import datetime as dt
+import itertools
 
 import pytest
 
@@ -12,7 +13,9 @@ from hrc.analytics.gantt import (
     ConstraintRow,
     build_gantt,
     draw_gantt,
+    format_duration,
     format_offset,
+    time_axis,
 )
 from hrc.analytics.metrics import InterruptionRow, ItemRow
 
@@ -197,37 +200,65 @@ def test_offsets_read_as_minutes_and_seconds_then_hours() -> None:
     ]
 
 
-def test_a_long_stretch_with_nothing_happening_is_drawn_shorter_on_a_broken_axis() -> None:
-    # Three short steps, then one that takes ten minutes: drawn to scale, the short ones
-    # would be slivers of a pixel or two.
-    gantt = build_gantt(
-        1, started_at=at(0), ended_at=at(612), now=at(700), actors=ACTORS,
-        items=[item(1, "tc1", "c", 0, 0, 4), item(2, "to1", "o", 4, 5, 8),
-               item(3, "tc2", "c", 8, 8, 608), item(4, "to2", "o", 608, 609, 612)],
-        constraints=[], interruptions=[],
-    )  # fmt: skip
-    drawing = draw_gantt(gantt, width=1000 + LABEL_WIDTH + RIGHT_MARGIN)
-    bars = {b.bar.work_item: b for b in drawing.bars}
-    assert bars[1].width > 60  # to scale it would be 1000 / 612 * 4 ≈ 6.5 px
-    assert bars[3].width < 10 * bars[1].width  # the long one no longer takes the chart
-    (cut,) = drawing.breaks
-    assert bars[3].x is not None
-    assert bars[3].x < cut.x < bars[3].x + bars[3].width
-    assert cut.seconds == pytest.approx(600 - 4 * 3)  # shown as four times the median stretch
-    # Time still runs left to right, and no tick falls inside the break.
-    xs = [bars[n].x or 0.0 for n in (1, 2, 3, 4)]
-    assert xs == sorted(xs)
-    assert all(abs(t.x - cut.x) > 1 for t in drawing.ticks)
-    assert drawing.ticks[0].label == "0:00"
-    assert drawing.ticks[-1].label == "10:10"
+def _one_long_bar() -> list[ItemRow]:
+    """Three short tasks around one that takes an hour."""
+    return [
+        item(1, "to1", "o", 0, 2, 8),
+        item(2, "tc1", "c", 8, 10, 3610),
+        item(3, "to2", "o", 3610, 3612, 3618),
+        item(4, "tc2", "c", 3618, 3619, 3625),
+    ]
 
 
-def test_a_chart_without_a_long_empty_stretch_keeps_its_scale() -> None:
+def test_one_long_bar_no_longer_squeezes_the_short_ones_to_a_sliver() -> None:
     gantt = build_gantt(
-        1, started_at=at(0), ended_at=at(30), now=at(30), actors=ACTORS,
-        items=[item(1, "tc1", "c", 0, 0, 10), item(2, "to1", "o", 10, 12, 30)],
-        constraints=[], interruptions=[],
+        1, started_at=at(0), ended_at=at(3625), now=at(4000), actors=ACTORS,
+        items=_one_long_bar(), constraints=[], interruptions=[],
     )  # fmt: skip
-    drawing = draw_gantt(gantt, width=300 + LABEL_WIDTH + RIGHT_MARGIN)
-    assert drawing.breaks == []
-    assert drawing.bars[0].width == pytest.approx(100)
+    drawing = draw_gantt(gantt, width=1100)
+    bars = {b.bar.task: b for b in drawing.bars}
+    linear = (1100 - RIGHT_MARGIN - LABEL_WIDTH) / 3625  # px per second without the break
+    assert 6 * linear < 2  # a sliver: why the axis breaks
+    assert bars["to1"].width > 60
+    assert bars["to2"].width > 60
+    assert bars["tc1"].width > bars["to1"].width  # the long bar stays the longest
+    assert bars["tc1"].seconds_worked == 3600  # and its tooltip keeps the real time
+    (broken,) = drawing.breaks
+    assert broken.hidden == 3600
+    assert broken.label == "1 h 00 min"
+    xs = {task: bar.x for task, bar in bars.items() if bar.x is not None}
+    assert xs["tc1"] < broken.x < xs["tc1"] + bars["tc1"].width
+    # Time still runs left to right, and the last bar ends at the right margin.
+    assert [xs[t] for t in ("to1", "tc1", "to2", "tc2")] == sorted(xs.values())
+    assert xs["tc2"] + bars["tc2"].width == pytest.approx(1100 - RIGHT_MARGIN)
+    # The axis reads the jump: a tick where the time after the break begins.
+    assert "1:00:10" in [t.label for t in drawing.ticks]
+    gaps = [b.x - a.x for a, b in itertools.pairwise(drawing.ticks)]
+    assert min(gaps) >= 48
+
+
+def test_an_axis_whose_typical_stretch_reads_well_is_one_linear_piece() -> None:
+    # 25 s stretches among 3 s ones, but 3 s of 60 is wide enough: nothing to break.
+    axis = time_axis([0, 2, 5, 6, 10, 35, 60], 60)
+    (piece,) = axis.pieces
+    assert (piece.start, piece.end, piece.shown_start, piece.shown_end) == (0, 60, 0, 60)
+    assert axis.shown(25) == 25
+    assert axis.breaks == []
+
+
+def test_a_long_idle_stretch_is_shortened_to_four_typical_ones() -> None:
+    axis = time_axis([0, 5, 10, 15, 1015, 1020], 1020)
+    (broken,) = axis.breaks
+    assert (broken.start, broken.end) == (15, 1015)
+    assert broken.shown_end - broken.shown_start == 20  # 4 x the median stretch (5 s), >= 10 s
+    assert axis.shown(1020) == 15 + 20 + 5
+    assert axis.shown(515) == pytest.approx(15 + 10)  # halfway through, halfway along
+
+
+def test_durations_read_in_seconds_minutes_then_hours() -> None:
+    assert [format_duration(s) for s in (45, 300, 3600, 3900)] == [
+        "45 s",
+        "5 min",
+        "1 h 00 min",
+        "1 h 05 min",
+    ]

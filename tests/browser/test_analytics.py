@@ -19,6 +19,7 @@ from hrc.patterns import services as pattern_services
 from tests import factories
 from tests.analytics.running import pin, pin_interruption, run_hand_over, run_shared_space
 from tests.analytics.xes_structure import NS, check_xes
+from tests.browser.conftest import assert_fits
 from tests.cases.patterns import shared_space
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -155,3 +156,46 @@ def test_operators_get_403_and_outsiders_404(
     assert response.status == 404
     download = page.request.get(f"{live_url}/api/analytics/xes/?case={cases[0].pk}")
     assert download.status == 404
+
+
+def test_a_long_bar_breaks_the_axis_and_the_short_bars_stay_readable(
+    page: Page,
+    live_url: str,
+    organisation: Organisation,
+    engineer: User,
+    operator: User,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    cobot = factories.make_cobot(organisation, name="ur5e-left")
+    pattern = factories.make_pattern(
+        organisation, name="Shared space", draft=shared_space(), created_by=engineer
+    )
+    version = pattern_services.publish_pattern(pattern, published_by=engineer)
+    case = run_shared_space(version, engineer, operator, cobot)
+    # The pick takes an hour; the operator's two tasks take 12 and 30 seconds.
+    pin(case, started=0, ended=3660,
+        items={"to1": (0, 8, 20), "tc1": (20, 24, 3624), "to2": (20, 40, 70)},
+        jobs_={"tc1": (20, 24, 3624)})  # fmt: skip
+    pin_interruption(case, 40, 70)
+    page.set_viewport_size({"width": 1280, "height": 800})
+    sign_in(page, engineer)
+    page.goto(f"{live_url}/analytics/cases/{case.pk}/gantt/")
+
+    chart = page.locator("svg.gantt")
+    gap = chart.locator("g.axis-break")
+    expect(gap).to_have_count(1)
+    expect(gap).to_have_attribute("data-hidden", "3554")  # from 70 s, to2's end, to 3624 s
+    expect(gap.locator("text")).to_have_text("⋯ 59 min ⋯")
+    short = chart.locator('g.bar[data-task="to1"] rect.work').bounding_box()
+    long = chart.locator('g.bar[data-task="tc1"] rect.work').bounding_box()
+    marker = gap.locator("rect").bounding_box()
+    assert short is not None
+    assert long is not None
+    assert marker is not None
+    assert short["width"] > 40  # 12 s of 3660: under 3 px on a linear axis
+    assert long["width"] > short["width"]
+    assert long["x"] < marker["x"] < long["x"] + long["width"]  # the break cuts the long bar
+    expect(chart.locator('g.bar[data-task="to1"] text.label')).to_be_visible()
+    screenshot(page, "analytics-gantt-broken-axis")
+    assert_fits(page)

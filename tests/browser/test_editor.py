@@ -22,6 +22,7 @@ from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel, PatternVersion
 from tests import factories
+from tests.browser.conftest import assert_fits
 from tests.browser.drawing import (
     CHECKED,
     append_node,
@@ -144,14 +145,15 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     expect(pattern_badge(page)).to_have_attribute("data-sound", "false", timeout=CHECKED)
     for task in ("tc2", "to1"):
         expect(page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')).to_be_visible()
-    deadlock = page.locator(".hrc-issue", has_text="can deadlock")
+    deadlock = page.locator(".hrc-issue", has_text="can get stuck")
+    # The firings in the drawing's words: tc1 is "pick insert".
     expect(deadlock.locator(".hrc-witness-steps li")).to_have_text(
-        ["t1", "start tc1", "complete tc1"]
+        ["t1", "start “pick insert”", "complete “pick insert”"]
     )
     deadlock.get_by_role("button", name="Play the witness").click()
     bar = page.get_by_role("toolbar", name="Token game")
     for _ in range(3):
-        bar.get_by_role("button", name="Next witness step ▶").click()
+        bar.get_by_role("button", name="Fire next step ↷").click()
     expect(bar.locator(".hrc-game-caption")).to_contain_text("Witness replayed (3 of 3)")
     # Where the witness ends: tc1 has completed, tc2 and to1 wait for each other.
     expect(page.locator('.djs-element[data-element-id="tc1"]')).not_to_have_class(RUNNING)
@@ -172,10 +174,11 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
         "Published version 1.", timeout=CHECKED
     )
     version = PatternVersion.objects.get()
-    # The next step is on the version's page.
-    page.get_by_role("link", name="Version 1: map actors and start cases").click()
-    page.wait_for_url(f"{live_url}/patterns/versions/{version.pk}/")
     assert version.number == 1
+    # The message leads to the version's page, by the id the publish API returned.
+    published = page.locator(".hrc-toolbar .hrc-status").get_by_role("link")
+    expect(published).to_have_text("Published version 1.")
+    expect(published).to_have_attribute("href", f"/patterns/versions/{version.pk}/")
     assert version.pattern.name == "Assembly (1 operator, 1 cobot)"
     _assert_is_the_thesis_assembly(version.document)
     screenshot(page, "editor-assembly-published")
@@ -379,39 +382,48 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
     page.get_by_role("button", name="Token game").click()
     bar = page.get_by_role("toolbar", name="Token game")
     caption = bar.locator(".hrc-game-caption")
-    expect(caption).to_have_text("Enabled: t1.")
+    expect(caption).to_have_text("Can fire: t1.")
 
     def tokens(place: str) -> Any:
         return page.locator(f'.djs-element[data-element-id="{place}"] .hrc-token')
 
     expect(tokens("p1")).to_have_count(1)
-    click_element(page, "tc1")  # not enabled yet: nothing fires, the caption says why
-    expect(caption).to_have_text(re.compile(r"is held back: .+ has no token yet\.$"))
+    click_element(page, "tc1")  # not enabled yet: nothing happens
+    expect(caption).to_have_text("Can fire: t1.")
     click_element(page, "t1")
     expect(tokens("p1")).to_have_count(0)
     expect(tokens("p2")).to_have_count(1)
     click_element(page, "tc1")
     expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
-    expect(caption).to_contain_text("Fired start tc1.")
+    expect(caption).to_contain_text("Fired: start “pick insert”.")
     click_element(page, "tc1")
-    expect(caption).to_contain_text("Fired complete tc1.")
+    expect(caption).to_contain_text("Fired: complete “pick insert”.")
     expect(tokens("p3")).to_have_count(1)
 
     # The constraint places, on demand: tc2 waits for to1's completion.
     bar.get_by_label("Constraint places").check()
     expect(page.locator(".hrc-constraint-place", has_text="to1 done, for tc2: 0")).to_be_visible()
+    # A click on the held-back task says which constraint holds it and whose task it waits for.
     click_element(page, "tc2")
     expect(page.locator('.djs-element[data-element-id="tc2"]')).not_to_have_class(RUNNING)
-    expect(caption).to_contain_text("the time constraint waits for")
+    expect(caption).to_have_text(
+        "“place insert” cannot start yet, held back by the time constraint "
+        "“prepare workpiece” → “place insert”: it waits for o's “prepare workpiece” to complete."
+    )
+    expect(page.locator('.djs-element[data-element-id="to1"]')).to_have_class(
+        re.compile("hrc-awaited")
+    )
     screenshot(page, "editor-token-game")
 
-    bar.get_by_role("button", name="◀ Undo firing").click()
+    # Back and forward are undo and redo of firings.
+    expect(bar.get_by_role("button", name="Redo firing ↷")).to_be_disabled()
+    bar.get_by_role("button", name="↶ Undo firing").click()
     expect(page.locator('.djs-element[data-element-id="tc1"]')).to_have_class(RUNNING)
-    bar.get_by_role("button", name="Redo firing ▶").click()
+    bar.get_by_role("button", name="Redo firing ↷").click()
     expect(tokens("p3")).to_have_count(1)
 
-    bar.get_by_role("button", name="Run randomly").click()
-    expect(caption).to_contain_text("Nothing is enabled.", timeout=20_000)
+    bar.get_by_role("button", name="Fire randomly").click()
+    expect(caption).to_contain_text("Nothing can fire.", timeout=20_000)
     expect(tokens("p9")).to_have_count(1)
     # Nothing was edited by playing.
     bar.get_by_role("button", name="Stop").click()
@@ -421,6 +433,7 @@ def test_the_token_game_fires_by_click_steps_back_and_runs_to_the_end(
 def test_a_refused_edit_says_why_and_draws_nothing(
     page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
 ) -> None:
+    page.set_viewport_size({"width": 1280, "height": 800})
     pattern = _assembly(organisation)
     sign_in(page, engineer)
     open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
@@ -440,6 +453,13 @@ def test_a_refused_edit_says_why_and_draws_nothing(
     expect(arcs).to_have_count(count)
     expect(constraints).to_have_count(2)
     expect(page.get_by_role("button", name="Undo")).to_be_disabled()
+    # The refusal leaves the constraints legend readable.
+    refusal, legend = hint.bounding_box(), page.locator(".hrc-legend").bounding_box()
+    assert refusal is not None
+    assert legend is not None
+    assert refusal["x"] >= legend["x"] + legend["width"] or (
+        refusal["y"] + refusal["height"] <= legend["y"]
+    ), (refusal, legend)
 
 
 def test_an_outsider_gets_404_for_our_pattern(
@@ -662,3 +682,83 @@ def test_a_lane_moves_up_with_its_tasks_and_one_undo_puts_it_back(
     until(lambda: near(element_box(page, "o"), operator))
     assert near(element_box(page, "c"), cobot)
     assert near(element_box(page, "to1"), operator_task)
+
+
+def test_a_constraint_shows_its_task_names_and_reverses_with_undo(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    page.set_viewport_size({"width": 1280, "height": 800})
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    # The first constraint of the example: to1 → tc2, drawn as a straight line between them.
+    (x1, y1), (x2, y2) = centre_of(page, "to1"), centre_of(page, "tc2")
+    page.mouse.click(x1 + (x2 - x1) / 2, y1 + (y2 - y1) / 2)
+    panel = page.get_by_role("region", name="Properties")
+    ends = panel.locator(".hrc-constraint-ends")
+    expect(ends).to_have_text("“prepare workpiece” → “place insert” (time)")
+    assert "to1" not in (ends.text_content() or "")
+    screenshot(page, "editor-constraint-panel-1280")
+    assert_fits(page)
+
+    panel.get_by_role("button", name="Reverse").click()
+    expect(ends).to_have_text("“place insert” → “prepare workpiece” (time)")
+    _save_and_expect_constraints(page, pattern, {("tc2", "to1"), ("tc3", "to2")})
+
+    page.get_by_role("button", name="Undo").click()
+    expect(ends).to_have_text("“prepare workpiece” → “place insert” (time)")
+    _save_and_expect_constraints(page, pattern, {("to1", "tc2"), ("tc3", "to2")})
+
+
+def _save_and_expect_constraints(
+    page: Page, pattern: PatternModel, expected: set[tuple[str, str]]
+) -> None:
+    page.get_by_role("button", name="Save").click()
+
+    def saved() -> bool:
+        pattern.refresh_from_db()
+        return {(c["from"], c["to"]) for c in pattern.draft["constraints"]} == expected
+
+    until(saved)
+
+
+def test_lanes_come_by_dragging_and_appended_branches_stay_in_their_lane(
+    page: Page, live_url: str, engineer: User, sign_in: SignIn
+) -> None:
+    sign_in(page, engineer)
+    open_editor(page, f"{live_url}/patterns/new/")
+    canvas = page.locator(".hrc-canvas").bounding_box()
+    assert canvas is not None
+    # Dragged from the palette and let go over the canvas, a lane tool adds its lane.
+    for tool in ("Cobot lane", "Operator lane"):
+        entry = page.get_by_role("button", name=tool, exact=True).bounding_box()
+        assert entry is not None
+        page.mouse.move(entry["x"] + entry["width"] / 2, entry["y"] + entry["height"] / 2)
+        page.mouse.down()
+        page.mouse.move(canvas["x"] + canvas["width"] / 2, canvas["y"] + 150, steps=10)
+        page.mouse.up()
+    expect(page.locator('.djs-element[data-element-id="c"]')).to_have_count(1)
+    expect(page.locator('.djs-element[data-element-id="o"]')).to_have_count(1)
+
+    # Three branches after one place in the cobot's lane: all three stay inside it.
+    cobot = element_box(page, "c")
+    drop_tool(page, "Place", cobot["x"] + 100, cobot["y"] + 30)
+    first = page.get_by_role("region", name="Properties").get_by_label("Id").input_value()
+    for _ in range(3):
+        select_element(page, first)
+        append_node(page)
+        page.keyboard.press("Escape")
+    lane = element_box(page, "c")
+    tasks = page.locator('.djs-element[data-element-id^="tc"] .djs-hit')
+    expect(tasks).to_have_count(3)
+    for n in range(3):
+        box = tasks.nth(n).bounding_box()
+        assert box is not None
+        assert lane["y"] <= box["y"]
+        assert box["y"] + box["height"] <= lane["y"] + lane["height"]

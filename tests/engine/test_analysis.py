@@ -21,8 +21,10 @@ def test_a_deadlock_comes_with_the_shortest_sequence_and_what_waits_for_what() -
 
     assert code == "unsound"
     assert witness == ("t1", "start tc1", "complete tc1")
-    assert "start tc2 waits for a completion of to1 (time constraint to1 → tc2)" in message
-    assert "start to1 waits for a completion of tc3 (time constraint tc3 → to1)" in message
+    assert "start of task tc2 waits for a completion of to1 (time constraint to1 → tc2)" in message
+    assert (
+        "the start of task to1 waits for a completion of tc3 (time constraint tc3 → to1)" in message
+    )
 
 
 def test_tasks_that_can_never_start_are_named_with_the_constraint_they_need() -> None:
@@ -31,7 +33,7 @@ def test_tasks_that_can_never_start_are_named_with_the_constraint_they_need() ->
     dead = next(e for e in check_document(data).errors if "never start" in e.message)
 
     assert set(dead.elements) == {"tc2", "tc3", "to1", "to2", "t2"}
-    assert "start to1 needs a completion of tc3" in dead.message
+    assert "the start of task to1 needs a completion of tc3" in dead.message
 
 
 def test_a_func_constraint_whose_supported_task_comes_later_deadlocks() -> None:
@@ -42,7 +44,7 @@ def test_a_func_constraint_whose_supported_task_comes_later_deadlocks() -> None:
 
     assert deadlock.witness == ("t1", "start tc1")
     assert (
-        "complete tc1 waits for to2 to complete (func constraint: tc1 supports to2)"
+        "completion of task tc1 waits for to2 to complete (func constraint: tc1 supports to2)"
         in deadlock.message
     )
 
@@ -159,5 +161,5 @@ def test_a_deadlock_without_constraints_names_what_the_join_lacks() -> None:
     deadlock = next(e for e in check_document(document(net)).errors if "deadlock" in e.message)
 
     assert deadlock.witness == ("start to2", "complete to2", "start to1", "complete to1")
-    assert deadlock.message.endswith("t2 waits for a token in p3")
+    assert deadlock.message.endswith("Split/join t2 waits for a token in place p3")
     assert deadlock.elements == ("t2",)

@@ -194,3 +194,62 @@ def test_mutations_do_not_leak_between_cases() -> None:
     _duplicate_id(copied)
 
     assert base != copied
+
+
+def _labelled(data: Doc) -> Doc:
+    labels = {"tc1": "Pick insert", "tc2": "Place insert", "to1": "Prepare workpiece"}
+    for transition in _net(data)["transitions"]:
+        if transition["id"] in labels:
+            transition["label"] = labels[transition["id"]]
+    return data
+
+
+def test_a_loose_place_is_explained_as_a_start_too_many_in_the_drawing() -> None:
+    data = _labelled(two_lanes([("to1", "tc2", "time")]))
+    _net(data)["places"].append({"id": "p42", "label": "Tray"})
+
+    issue = next(i for i in check_document(data).errors if i.code == "not-workflow-net")
+
+    assert issue.message.startswith(
+        "The drawing has 2 places where a case could start (place p1 and place “Tray”"
+    )
+    assert "2 places where a case could end" in issue.message
+    assert "source places" not in issue.message
+    assert "(none)" not in issue.message
+    assert "p42" in issue.elements
+
+
+def test_a_constraint_broken_rule_names_the_tasks_by_their_labels() -> None:
+    data = _labelled(two_lanes([("tc1", "tc2", "time")]))
+
+    issue = next(i for i in check_document(data).errors if i.code == "constraint-same-performer")
+
+    assert issue.message.startswith(
+        "The time constraint “Pick insert” → “Place insert” joins two tasks of the same cobot c"
+    )
+    assert issue.elements == ("tc1", "tc2")
+
+
+def test_a_deadlock_is_told_in_task_names_with_the_constraint_that_holds_it() -> None:
+    data = _labelled(two_lanes([("to1", "tc2", "time"), ("tc3", "to1", "time")]))
+
+    issue = next(i for i in check_document(data).errors if i.code == "unsound")
+
+    assert issue.message.startswith(
+        "The pattern can get stuck: after split/join t1 fires, “Pick insert” starts, "
+        "“Pick insert” completes, nothing more can happen"
+    )
+    assert (
+        "The start of “Place insert” waits for a completion of “Prepare workpiece” "
+        "(time constraint “Prepare workpiece” → “Place insert”)"
+    ) in issue.message
+    assert issue.witness == ("t1", "start tc1", "complete tc1")  # ids, for the editor's replay
+
+
+def test_an_arc_between_two_places_says_what_to_put_between_them() -> None:
+    data = _mutated(_arc_between_places)
+
+    issue = next(i for i in check_document(data).errors if i.code == "arc-kind")
+
+    assert issue.message.startswith("The arrow from place p2 to place p3 joins two places")
+    assert issue.elements == ("p2", "p3")

@@ -91,7 +91,7 @@ def test_a_cobot_task_that_names_no_program_is_refused_when_checked(task: object
     issues = [i for i in check_document(data).errors if i.code == "task-config"]
 
     assert [i.elements for i in issues] == [("tc1",)]
-    assert issues[0].message.startswith("tc1: the cobot task names no program")
+    assert issues[0].message.startswith("Task tc1: the cobot task names no program")
     assert "'c'" in issues[0].message
 
 
@@ -417,7 +417,7 @@ def test_only_silent_transitions_have_a_guard_or_message(key: str, value: object
     issues = config_issues(read_pattern(_doc(tc1={key: value})))
 
     assert [(i.code, i.elements) for i in issues] == [("task-config", ("tc1",))]
-    assert issues[0].message == f"tc1: only silent transitions have a '{key}'."
+    assert issues[0].message == f"Task tc1: only silent transitions have a '{key}'."
 
 
 # The check ------------------------------------------------------------------------------
@@ -437,7 +437,7 @@ def test_config_issues_are_task_config_errors_naming_each_transition() -> None:
         ("task-config", "error", ("x1",)),
         ("task-config", "error", ("to1",)),
     ]
-    assert [i.message.split(":")[0] for i in issues] == ["tc1", "x1", "to1"]
+    assert [i.message.split(":")[0] for i in issues] == ["Task tc1", "Split/join x1", "Task to1"]
 
 
 def test_a_well_configured_pattern_has_no_config_issues() -> None:

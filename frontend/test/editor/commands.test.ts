@@ -114,3 +114,30 @@ describe("new elements", () => {
     expect(factory.isTaken("N")).toBe(true);
   });
 });
+
+describe("constraint.reverse", () => {
+  test("swaps the constraint's tasks and one undo swaps them back", () => {
+    const operator = register({ businessObject: { kind: "transition", process: "N", silent: false, data: { id: "to1", performer: "o", label: "Press the button" } } });
+    const cobot = register({ businessObject: { kind: "transition", process: "N", silent: false, data: { id: "tc1", performer: "c", label: "Move part" } } });
+    const constraint = factory.createConnection({
+      id: "constraint-1",
+      source: operator,
+      target: cobot,
+      waypoints: [{ x: 0, y: 0 }, { x: 10, y: 20 }],
+      businessObject: { kind: "constraint", data: { from: "to1", to: "tc1", type: "time" } },
+    });
+    registry.add(constraint, document.createElementNS("http://www.w3.org/2000/svg", "g"));
+
+    modeling.reverseConstraint(constraint);
+    expect([constraint.source?.id, constraint.target?.id]).toEqual(["tc1", "to1"]);
+    expect(constraint.waypoints).toEqual([{ x: 10, y: 20 }, { x: 0, y: 0 }]);
+    expect(cobot.outgoing).toEqual([constraint]);
+    expect(operator.incoming).toEqual([constraint]);
+    expect(operator.outgoing).toEqual([]);
+
+    stack.undo();
+    expect([constraint.source?.id, constraint.target?.id]).toEqual(["to1", "tc1"]);
+    expect(operator.outgoing).toEqual([constraint]);
+    expect(cobot.incoming).toEqual([constraint]);
+  });
+});

@@ -1,6 +1,6 @@
 import { describe, expect, test } from "vitest";
 
-import { type ExecutionNet, readExecutionNet, TokenGame } from "../../src/editor/model/net";
+import { type ExecutionNet, heldBackWords, readExecutionNet, TokenGame } from "../../src/editor/model/net";
 
 /**
  * The execution net of: p0 → t1 (silent split) → p1 → to1 (operator) → p2 → tc1 (cobot) → p3,
@@ -20,10 +20,10 @@ function handOver(constraint: "to1>tc1" | "tc1>to1" = "to1>tc1"): ExecutionNet {
     ],
     transitions: [
       { id: "t1", label: "t1", kind: "silent", task: "t1" },
-      { id: "start:to1", label: "start to1", kind: "start", task: "to1" },
-      { id: "complete:to1", label: "complete to1", kind: "complete", task: "to1" },
-      { id: "start:tc1", label: "start tc1", kind: "start", task: "tc1" },
-      { id: "complete:tc1", label: "complete tc1", kind: "complete", task: "tc1" },
+      { id: "start:to1", label: "start to1", kind: "start", task: "to1", performer: "o" },
+      { id: "complete:to1", label: "complete to1", kind: "complete", task: "to1", performer: "o" },
+      { id: "start:tc1", label: "start tc1", kind: "start", task: "tc1", performer: "c" },
+      { id: "complete:tc1", label: "complete tc1", kind: "complete", task: "tc1", performer: "c" },
     ],
     arcs: [
       ["p0", "t1"], ["t1", "p1"],
@@ -113,19 +113,27 @@ describe("the token game", () => {
   });
 });
 
-describe("what holds a task back", () => {
-  test("names the constraint and the task it waits for, or the place without a token", () => {
+describe("a task held back by a constraint", () => {
+  const names: Record<string, string> = { to1: "“Press the button”", tc1: "“Move part”" };
+  const name = (id: string) => names[id] ?? id;
+
+  test("says which constraint and which other actor's task it waits for", () => {
+    // tc1 -> to1: the operator's to1 waits for the cobot's tc1, which comes later in the flow.
     const game = new TokenGame(handOver("tc1>to1"));
     game.fire("t1");
-    expect(game.heldBack("to1")).toEqual([{ kind: "constraint", type: "time", waitsFor: "tc1" }]);
-    expect(game.heldBack("tc1")).toEqual([{ kind: "flow", place: "p2" }]);
-    expect(game.heldBack("t1")).toEqual([{ kind: "flow", place: "p0" }]);
+
+    expect(game.firingFor("to1")).toBeNull();
+    expect(game.heldBack("to1").map((place) => place.id)).toEqual(["time:tc1>to1"]);
+    expect(heldBackWords(game, "to1", name)).toBe(
+      "“Press the button” cannot start yet, held back by the time constraint “Move part” → “Press the button”: it waits for c's “Move part” to complete.",
+    );
   });
 
-  test("is nothing for a task that can fire", () => {
+  test("a task that waits for its flow is not held back by a constraint", () => {
     const game = new TokenGame(handOver());
-    game.fire("t1");
-    expect(game.heldBack("to1")).toEqual([]);
+
+    expect(game.heldBack("tc1")).toEqual([]);
+    expect(heldBackWords(game, "tc1", name)).toBe("");
   });
 });
 

@@ -24,6 +24,8 @@ export interface NetTransition {
   label: string;
   kind: FiringKind;
   task: string;
+  /** The actor who performs the task; null for a silent step. */
+  performer: string | null;
 }
 
 export interface ExecutionNet {
@@ -49,7 +51,8 @@ export function readExecutionNet(value: unknown): ExecutionNet {
     const id = String(transition.id);
     const kind = (["start", "complete", "silent"].includes(String(transition.kind)) ? transition.kind : id.includes(":") ? id.split(":")[0] : "silent") as FiringKind;
     const task = String(transition.task ?? (id.includes(":") ? id.split(":").slice(1).join(":") : id));
-    return { id, label: String(transition.label ?? (kind === "silent" ? task : `${kind} ${task}`)), kind, task };
+    const performer = typeof transition.performer === "string" ? transition.performer : null;
+    return { id, label: String(transition.label ?? (kind === "silent" ? task : `${kind} ${task}`)), kind, task, performer };
   });
   const arcs = (Array.isArray(value.arcs) ? value.arcs : []).flatMap((arc): [string, string][] => {
     if (Array.isArray(arc) && arc.length >= 2) {
@@ -81,9 +84,6 @@ function ofList(of: unknown, id: string, kind: PlaceKind): string[] {
 }
 
 export type Marking = Map<string, number>;
-
-/** What holds a task back in the token game: a constraint waiting for another task, or an empty place. */
-export type HeldBack = { kind: "constraint"; type: string; waitsFor: string } | { kind: "flow"; place: string };
 
 /** The token game: a marking, the firings that led to it, and the ones undone (to step forward again). */
 export class TokenGame {
@@ -170,27 +170,22 @@ export class TokenGame {
   }
 
   /**
-   * Why a pattern task can neither start nor complete now: for each of its firings, the input
-   * places that lack a token. A constraint place names the constraint's type and the task at its
-   * other end, which has to happen first; a flow place is the model's own order. Empty when the
-   * task can fire.
+   * Why a click on `task` fires nothing though its flow is there: the constraint
+   * places its next firing (start, or completion while it runs) lacks. Empty when
+   * it can fire, or when it also waits for tokens of the flow.
    */
-  heldBack(task: string): HeldBack[] {
-    if (this.firingFor(task)) return [];
-    const firings = this.net.transitions.filter((t) => t.task === task && t.kind !== "complete");
-    const reasons = new Map<string, HeldBack>();
-    for (const firing of firings) {
-      for (const [placeId, weight] of this.pre.get(firing.id) ?? []) {
-        if (this.tokens(placeId) >= weight) continue;
-        const place = this.net.places.find((p) => p.id === placeId);
-        if (!place || place.kind === "busy") continue;
-        if (place.kind === "constraint") {
-          const other = place.of.find((element) => element !== task) ?? place.of[0];
-          reasons.set(placeId, { kind: "constraint", type: placeId.slice(0, placeId.indexOf(":")) || "constraint", waitsFor: other });
-        } else reasons.set(placeId, { kind: "flow", place: place.of[0] ?? placeId });
-      }
-    }
-    return [...reasons.values()];
+  heldBack(task: string): NetPlace[] {
+    const kind: FiringKind = this.isRunning(task) ? "complete" : "start";
+    const firing = this.net.transitions.find((t) => t.task === task && t.kind === kind);
+    if (!firing || this.isEnabled(firing)) return [];
+    const missing = [...(this.pre.get(firing.id) ?? [])].filter(([place, weight]) => this.tokens(place) < weight);
+    const places = missing.map(([id]) => this.net.places.find((place) => place.id === id));
+    return places.every((place) => place?.kind === "constraint") ? (places as NetPlace[]) : [];
+  }
+
+  /** The actor who performs a pattern task, as the execution net says; null for a silent step. */
+  performerOf(task: string): string | null {
+    return this.net.transitions.find((t) => t.task === task)?.performer ?? null;
   }
 
   /** Whether a pattern task is running (its busy place holds a token). */
@@ -241,4 +236,24 @@ function add(arcs: Map<string, Map<string, number>>, transition: string, place: 
   const weights = arcs.get(transition) ?? new Map<string, number>();
   weights.set(place, (weights.get(place) ?? 0) + 1);
   arcs.set(transition, weights);
+}
+
+/**
+ * Why a task is held back, in the drawing's words: which constraint and which
+ * other actor's task it waits for. `name` turns a task id into its label.
+ */
+export function heldBackWords(game: TokenGame, task: string, name: (id: string) => string): string {
+  const reasons = game.heldBack(task).map((place) => {
+    const role = place.id.slice(0, place.id.indexOf(":"));
+    const other = place.of.find((id) => id !== task) ?? place.of[0];
+    const actor = game.performerOf(other);
+    const whose = actor ? `${actor}'s ${name(other)}` : name(other);
+    const [from, to] = place.of;
+    if (role === "time") return `the time constraint ${name(from)} → ${name(to)}: it waits for ${whose} to complete`;
+    if (role === "func-start") return `the func constraint with ${name(other)}: it starts only while ${whose} runs`;
+    return `the func constraint with ${name(other)}: it completes only after ${whose} has completed`;
+  });
+  if (reasons.length === 0) return "";
+  const verb = game.isRunning(task) ? "cannot complete yet" : "cannot start yet";
+  return `${name(task)} ${verb}, held back by ${reasons.join("; and by ")}.`;
 }

@@ -11,6 +11,7 @@ import type Canvas from "diagram-js/lib/core/Canvas";
 
 import type { CheckIssue, CheckReport } from "../../api";
 import type TokenGameMode from "../token-game/TokenGameMode";
+import { listOfNames } from "../../model/words";
 
 const PATTERN_WORDS: Record<string, string> = {
   synchronized: "Synchronized",
@@ -65,6 +66,10 @@ export default class CheckPanel {
     this.list.replaceChildren(paragraph(summary, report.valid ? "hrc-ok" : "hrc-error"), ...items);
   }
 
+  private nameOf(id: string): string {
+    return this.tokenGame.nameOf(id);
+  }
+
   private item(issue: CheckIssue, severity: "error" | "warning"): HTMLElement {
     const item = document.createElement("article");
     item.className = `hrc-issue hrc-${severity}`;
@@ -73,7 +78,8 @@ export default class CheckPanel {
     text.textContent = issue.message;
     const known = issue.elements.filter((id) => this.elementRegistry.get(id));
     if (known.length) {
-      const show = button(`Show ${known.join(", ")}`, item);
+      const show = button(`Show ${listOfNames(known, (id) => this.nameOf(id))}`, item);
+      show.title = `Select ${listOfNames(known, (id) => this.nameOf(id), known.length)} in the drawing`;
       show.addEventListener("click", () => {
         const elements = known.map((id) => this.elementRegistry.get(id)).filter((e) => e !== undefined);
         this.selection.select(elements);
@@ -84,7 +90,11 @@ export default class CheckPanel {
       const play = button("Play the witness", item);
       play.classList.add("hrc-play-witness");
       const steps = element("ol", "hrc-witness-steps", item);
-      for (const label of issue.witness) element("li", "", steps).textContent = label;
+      for (const label of issue.witness) {
+        const step = element("li", "", steps);
+        step.textContent = this.tokenGame.stepWords(label);
+        step.dataset.firing = label;
+      }
       play.addEventListener("click", () => void this.tokenGame.replay(issue.witness as string[], issue.elements));
     }
     return item;

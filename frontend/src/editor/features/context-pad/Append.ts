@@ -7,7 +7,7 @@
 import type AutoPlace from "diagram-js/lib/features/auto-place/AutoPlace";
 import type EventBus from "diagram-js/lib/core/EventBus";
 import type { Shape } from "diagram-js/lib/model/Types";
-import { findFreePosition, generateGetNextPosition } from "diagram-js/lib/features/auto-place/AutoPlaceUtil";
+import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
 import { asTRBL, getMid } from "diagram-js/lib/layout/LayoutUtil";
 
 import { centre, isNode, laneAt, nodeObject, type NodeObject } from "../../core/elements";
@@ -16,11 +16,12 @@ import { newTaskRefusal } from "../../model/rules";
 import type LaneBehavior from "../lanes/LaneBehavior";
 import type LabelEditing from "../label-editing/LabelEditing";
 import type Refusals from "../rules/Refusals";
+import { placeInLane } from "./placement";
 
 export type AppendKind = "place" | "task" | "silent";
 
 export default class Append {
-  static $inject = ["eventBus", "autoPlace", "elementFactory", "laneBehavior", "refusals", "labelEditing"];
+  static $inject = ["eventBus", "autoPlace", "elementFactory", "laneBehavior", "refusals", "labelEditing", "elementRegistry"];
 
   constructor(
     eventBus: EventBus,
@@ -29,12 +30,16 @@ export default class Append {
     private readonly laneBehavior: LaneBehavior,
     private readonly refusals: Refusals,
     private readonly labelEditing: LabelEditing,
+    private readonly elementRegistry: ElementRegistry,
   ) {
-    // Right of the source; further down when that spot is taken (a split's second branch).
+    // Right of the source, in the source's lane; below or above when that spot is taken
+    // (a split's second branch), never across the lane's border.
     eventBus.on("autoPlace", 1500, (event: { source: Shape; shape: Shape }) => {
       const { source, shape } = event;
       const position = { x: asTRBL(source).right + 60 + shape.width / 2, y: getMid(source).y };
-      return findFreePosition(source, shape, position, generateGetNextPosition({ y: { margin: 40, minDistance: 30 } }));
+      const lane = laneAt(this.laneBehavior.lanes(), centre(source).y);
+      const taken = (this.elementRegistry.filter(isNode) as Shape[]).filter((node) => node !== shape);
+      return placeInLane(position, shape, lane, taken);
     });
   }
 

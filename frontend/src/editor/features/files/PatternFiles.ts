@@ -21,6 +21,13 @@ export type ExportFormat = "json" | "pnml" | "bpmn";
 export interface FilesMessage {
   text: string;
   kind: "info" | "error";
+  /** Where the message leads: the whole text becomes a link there. */
+  href?: string;
+}
+
+/** A published version's page (the `patterns:version` URL). */
+export function versionPage(id: number): string {
+  return `/patterns/versions/${id}/`;
 }
 
 export default class PatternFiles {
@@ -84,7 +91,7 @@ export default class PatternFiles {
     await this.run("Publishing…", async () => {
       const version = await this.api.publish(this.id as number);
       this.eventBus.fire("files.published", { version });
-      return `Published version ${version.number}.`;
+      return { text: `Published version ${version.number}.`, kind: "info", href: versionPage(version.id) };
     });
   }
 
@@ -113,11 +120,12 @@ export default class PatternFiles {
     link.remove();
   }
 
-  private async run(pending: string, work: () => Promise<string>): Promise<void> {
+  private async run(pending: string, work: () => Promise<string | FilesMessage>): Promise<void> {
     this.busy = true;
     this.say({ text: pending, kind: "info" });
     try {
-      this.say({ text: await work(), kind: "info" });
+      const done = await work();
+      this.say(typeof done === "string" ? { text: done, kind: "info" } : done);
     } catch (error) {
       this.say({ text: (error as Error).message, kind: "error" });
     } finally {

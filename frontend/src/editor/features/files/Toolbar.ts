@@ -33,6 +33,7 @@ export default class Toolbar {
         show({ text: (error as Error).message, kind: "error" });
       }
     });
+    name.addEventListener("input", () => fitToText(name));
     // Enter keeps the name and goes back to drawing.
     name.addEventListener("keydown", (event) => {
       if (event.key === "Enter") canvas.focus();
@@ -95,23 +96,19 @@ export default class Toolbar {
     status.setAttribute("role", "status");
     bar.appendChild(status);
     const show = (message: FilesMessage) => {
-      status.textContent = message.text;
+      if (message.href) {
+        const link = document.createElement("a");
+        link.href = message.href;
+        link.textContent = message.text;
+        status.replaceChildren(link);
+      } else status.textContent = message.text;
       status.dataset.kind = message.kind;
       status.setAttribute("role", message.kind === "error" ? "alert" : "status");
     };
     eventBus.on("files.message", show);
-    // After publishing, the next step is on the version's page: who does what, and start cases.
-    const next = document.createElement("a");
-    next.className = "hrc-next";
-    next.hidden = true;
-    bar.appendChild(next);
-    eventBus.on("files.published", ({ version }: { version: { id: number; number: number } }) => {
-      next.href = `/patterns/versions/${version.id}/`;
-      next.textContent = `Version ${version.number}: map actors and start cases`;
-      next.hidden = false;
-    });
     eventBus.on(["files.changed", "commandStack.changed", "import.done"], () => {
       name.value = files.name;
+      fitToText(name);
       undo.disabled = !commandStack.canUndo();
       redo.disabled = !commandStack.canRedo();
       save.disabled = !pattern.canWrite || files.busy;
@@ -122,4 +119,16 @@ export default class Toolbar {
       if (files.dirty) event.preventDefault();
     });
   }
+}
+
+const measure = document.createElement("canvas").getContext("2d");
+
+/** Widens the name field to its whole text (the toolbar's width at most, by CSS), so no name is cut off. */
+function fitToText(input: HTMLInputElement): void {
+  if (!measure) return;
+  const style = getComputedStyle(input);
+  measure.font = style.font;
+  const text = measure.measureText(input.value || input.placeholder).width;
+  const frame = ["paddingLeft", "paddingRight", "borderLeftWidth", "borderRightWidth"].reduce((sum, key) => sum + (parseFloat(style[key as "paddingLeft"]) || 0), 0);
+  input.style.width = `${Math.max(208, Math.ceil(text + frame + 8))}px`;
 }

@@ -7,12 +7,13 @@ import Modeling from "diagram-js/lib/features/modeling/Modeling";
 import type CommandStack from "diagram-js/lib/command/CommandStack";
 import type EventBus from "diagram-js/lib/core/EventBus";
 import type { ElementLike } from "diagram-js/lib/core/Types";
-import type { Shape } from "diagram-js/lib/model/Types";
+import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
 import type { ActorType, Extra } from "../../model/document";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import AddLaneHandler, { type AddLaneContext } from "./AddLaneHandler";
 import MoveLaneHandler, { type MoveLaneContext } from "./MoveLaneHandler";
+import ReverseConstraintHandler, { type ReverseConstraintContext } from "./ReverseConstraintHandler";
 import UpdateDataHandler from "./UpdateDataHandler";
 import UpdateIdHandler from "./UpdateIdHandler";
 
@@ -35,6 +36,7 @@ export default class PatternModeling extends Modeling {
       "element.updateId": UpdateIdHandler,
       "lane.add": AddLaneHandler,
       "lane.move": MoveLaneHandler,
+      "constraint.reverse": ReverseConstraintHandler,
     };
   }
 
@@ -55,6 +57,12 @@ export default class PatternModeling extends Modeling {
   moveLane(lane: Shape, by: -1 | 1): void {
     const context: MoveLaneContext = { lane, by };
     this.commands.execute("lane.move", context);
+  }
+
+  /** Swaps a constraint's source and target task, as one undoable step. */
+  reverseConstraint(connection: Connection): void {
+    const context: ReverseConstraintContext = { connection };
+    this.commands.execute("constraint.reverse", context);
   }
 
   addLane(type: ActorType, id?: string): Shape {

@@ -5,6 +5,8 @@ import type Create from "diagram-js/lib/features/create/Create";
 import type HandTool from "diagram-js/lib/features/hand-tool/HandTool";
 import type LassoTool from "diagram-js/lib/features/lasso-tool/LassoTool";
 import type GlobalConnect from "diagram-js/lib/features/global-connect/GlobalConnect";
+import type Dragging from "diagram-js/lib/features/dragging/Dragging";
+import type EventBus from "diagram-js/lib/core/EventBus";
 
 import type { ActorType } from "../../model/document";
 import type { NodeObject } from "../../core/elements";
@@ -12,10 +14,12 @@ import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
 import { entryHtml } from "./icons";
 
+const LANE_DRAG = "lane.drag";
+
 type Entry = { group: string; title: string; html: string; action: Record<string, (event: Event) => void> };
 
 export default class PaletteProvider {
-  static $inject = ["palette", "create", "elementFactory", "handTool", "lassoTool", "globalConnect", "modeling"];
+  static $inject = ["palette", "create", "elementFactory", "handTool", "lassoTool", "globalConnect", "modeling", "dragging", "eventBus"];
 
   constructor(
     palette: Palette,
@@ -25,8 +29,14 @@ export default class PaletteProvider {
     private readonly lassoTool: LassoTool,
     private readonly globalConnect: GlobalConnect,
     private readonly modeling: PatternModeling,
+    private readonly dragging: Dragging,
+    eventBus: EventBus,
   ) {
     palette.registerProvider(this);
+    // A lane tool dragged and let go over the canvas adds the lane, as a click does.
+    eventBus.on(`${LANE_DRAG}.end`, (event: { hover?: unknown; context: { type: ActorType } }) => {
+      if (event.hover) this.modeling.addLane(event.context.type);
+    });
   }
 
   getPaletteEntries(): Record<string, Entry> {
@@ -56,6 +66,7 @@ export default class PaletteProvider {
   }
 
   private lane(title: string, type: ActorType): Entry {
-    return { group: "lanes", title, html: entryHtml(type), action: { click: () => this.modeling.addLane(type) } };
+    const drag = (event: Event) => this.dragging.init(event as MouseEvent, LANE_DRAG, { data: { context: { type } } });
+    return { group: "lanes", title, html: entryHtml(type), action: { click: () => this.modeling.addLane(type), dragstart: drag } };
   }
 }

@@ -13,6 +13,7 @@ import { PATTERN_NAMES } from "../../model/document";
 import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
+import { quotedName } from "../../model/words";
 import { isLane, lanesTopDown, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
@@ -46,7 +47,10 @@ export default class PropertiesPanel {
     this.panel.replaceChildren();
     const element = selected.length === 1 ? selected[0] : null;
     const object = objectOf(element) as PatternObject | undefined;
-    if (selected.length > 1) return note(this.panel, `${selected.length} elements selected.`);
+    if (selected.length > 1) {
+      note(this.panel, `${selected.length} elements selected.`);
+      return;
+    }
     if (!element || !object || object.kind === "root") return this.patternSection();
     if (object.kind === "place" || object.kind === "transition") this.nodeSection(element as Shape, object);
     else if (object.kind === "lane") this.laneSection(element as Shape);
@@ -124,7 +128,14 @@ export default class PropertiesPanel {
 
   private constraintSection(connection: Connection, object: ConstraintObject): void {
     heading(this.panel, "Constraint");
-    note(this.panel, `From ${connection.source?.id} to ${connection.target?.id}.`);
+    const name = (element: Connection["source"]) => {
+      const data = (objectOf(element) as { data?: { label?: string } } | undefined)?.data;
+      return element ? quotedName(element.id, data?.label) : "?";
+    };
+    const words = note(this.panel, `${name(connection.source)} → ${name(connection.target)} (${object.data.type})`);
+    words.classList.add("hrc-constraint-ends");
+    const reverse = button(this.panel, "Reverse", () => this.modeling.reverseConstraint(connection));
+    reverse.title = "Swap the two tasks: the constraint then runs the other way";
     select(this.panel, "Kind", object.data.type, CONSTRAINT_TYPES.map((type): [string, string] => [type, type]), (type) => this.modeling.updateData(connection, { type, interrupt: type === "space" ? object.data.interrupt : undefined }));
     if (object.data.type === "space") {
       select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), [["pause", "pauses"], ["slow", "slows down"]], (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));

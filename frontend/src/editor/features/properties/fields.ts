@@ -77,8 +77,10 @@ export function heading(parent: HTMLElement, text: string): void {
   add(parent, "h3", "").textContent = text;
 }
 
-export function note(parent: HTMLElement, text: string): void {
-  add(parent, "p", "hrc-note").textContent = text;
+export function note(parent: HTMLElement, text: string): HTMLElement {
+  const node = add(parent, "p", "hrc-note");
+  node.textContent = text;
+  return node;
 }
 
 export function button(parent: HTMLElement, text: string, run: () => void): HTMLButtonElement {

@@ -25,11 +25,12 @@ export default class GameBar {
       this.bar.appendChild(button);
       return button;
     };
-    // Undo and redo move through the firings made; while a witness is replayed, "next step"
-    // fires its next firing. Firing itself is a click on a task.
-    add("◀ Undo firing", () => tokenGame.back());
-    const forward = add("Redo firing ▶", () => tokenGame.forward());
-    add("Run randomly", () => tokenGame.runRandomly());
+    // Back and forward step through the firings already made: undo and redo, not "fire".
+    const undo = add("↶ Undo firing", () => tokenGame.back());
+    undo.title = "Take back the last firing";
+    const redo = add("Redo firing ↷", () => tokenGame.forward());
+    redo.title = "Fire again the firing just undone, or the witness' next step";
+    add("Fire randomly", () => tokenGame.runRandomly()).title = "Fire enabled tasks at random until nothing can fire";
     add("Reset", () => tokenGame.reset());
     const toggle = document.createElement("label");
     toggle.innerHTML = '<input type="checkbox"> Constraint places';
@@ -49,7 +50,10 @@ export default class GameBar {
     });
     eventBus.on("tokenGame.changed", (event: { caption: string }) => {
       this.caption.textContent = event.caption;
-      forward.textContent = tokenGame.replaying ? "Next witness step ▶" : "Redo firing ▶";
+      const game = tokenGame.game;
+      undo.disabled = !game || game.history.length === 0;
+      redo.disabled = !game || game.future.length === 0;
+      redo.textContent = tokenGame.replaying ? "Fire next step ↷" : "Redo firing ↷";
     });
   }
 }

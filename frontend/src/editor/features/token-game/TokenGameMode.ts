@@ -13,12 +13,13 @@ import type Overlays from "diagram-js/lib/features/overlays/Overlays";
 import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
 import type { Api } from "../../api";
-import { type NetTransition, readExecutionNet, TokenGame } from "../../model/net";
+import { heldBackWords, type NetTransition, readExecutionNet, TokenGame } from "../../model/net";
 import { isConstraint, isNode, objectOf } from "../../core/elements";
+import { listOfNames, quotedName } from "../../model/words";
 import type PatternImporter from "../../core/PatternImporter";
 
 const OVERLAY = "hrc-game";
-const MARKERS = ["hrc-enabled", "hrc-running", "hrc-fired", "hrc-stuck"];
+const MARKERS = ["hrc-enabled", "hrc-running", "hrc-fired", "hrc-stuck", "hrc-held", "hrc-awaited"];
 
 export interface Replay {
   labels: string[];
@@ -85,42 +86,36 @@ export default class TokenGameMode {
     this.eventBus.fire("tokenGame.stopped", {});
   }
 
-  /** What a click on a node does: fire the task's completion, its start, or the silent transition;
-   * on a task that cannot fire, the caption says what holds it back. */
+  /**
+   * What a click on a node does: fire the task's completion, its start, or the
+   * silent transition; a task a constraint holds back says why instead.
+   */
   fireTask(id: string): NetTransition | null {
     const game = this.game;
-    if (!game) return null;
-    const firing = game.firingFor(id);
-    if (!firing) {
-      if (objectOf(this.elementRegistry.get(id))?.kind === "transition") {
-        this.eventBus.fire("tokenGame.changed", { caption: this.heldBackCaption(game, id) });
-      }
-      return null;
-    }
+    const firing = game?.firingFor(id) ?? null;
+    if (game && !firing) this.explainHeldBack(game, id);
+    if (!game || !firing) return null;
     game.fire(firing.id);
     this.replaying = null;
     this.render();
     return firing;
   }
 
-  /** The caption for a click on a task that cannot fire, in the drawing's words. */
-  heldBackCaption(game: TokenGame, id: string): string {
-    const reasons = game.heldBack(id);
-    const task = this.nameOf(id);
-    if (reasons.length === 0) return `${task} cannot fire now.`;
-    const words = reasons.map((reason) =>
-      reason.kind === "constraint"
-        ? `the ${reason.type.replace(/-.*/, "")} constraint waits for ${this.nameOf(reason.waitsFor)}`
-        : `${this.nameOf(reason.place)} has no token yet`,
-    );
-    return `${task} is held back: ${words.join("; ")}.`;
+  /** The task's name as drawn: its label in quotes, its id where it has none. */
+  nameOf(id: string): string {
+    const data = (objectOf(this.elementRegistry.get(id)) as { data?: { label?: string } } | undefined)?.data;
+    return quotedName(id, data?.label);
   }
 
-  private nameOf(id: string): string {
-    const object = objectOf(this.elementRegistry.get(id));
-    const data = object && "data" in object ? (object.data as { label?: unknown }) : undefined;
-    const label = typeof data?.label === "string" ? data.label.trim() : "";
-    return label ? `“${label}”` : id;
+  private explainHeldBack(game: TokenGame, task: string): void {
+    const words = heldBackWords(game, task, (id) => this.nameOf(id));
+    if (!words) return;
+    this.render();
+    for (const place of game.heldBack(task)) {
+      for (const other of place.of) if (other !== task && this.elementRegistry.get(other)) this.mark(other, "hrc-awaited");
+    }
+    this.mark(task, "hrc-held");
+    this.eventBus.fire("tokenGame.changed", { caption: words });
   }
 
   back(): void {
@@ -166,14 +161,27 @@ export default class TokenGameMode {
       const done = game.history.length;
       const total = done + game.future.length;
       if (game.future.length === 0) {
-        return `Witness replayed (${done} of ${total}): ${this.replaying.labels.join(", ") || "from the start"}. Nothing more can happen for ${this.replaying.elements.join(", ")}.`;
+        const steps = this.replaying.labels.map((label) => this.stepWords(label)).join(", ");
+        return `Witness replayed (${done} of ${total}): ${steps || "from the start"}. Nothing more can happen for ${listOfNames(this.replaying.elements, (id) => this.nameOf(id), 6)}.`;
       }
-      return `Witness step ${done} of ${total}${last ? `: ${last.label}` : ""}. Next: ${game.future[0].label}.`;
+      return `Witness step ${done} of ${total}${last ? `: ${this.firingWords(last)}` : ""}. Next: ${this.firingWords(game.future[0])}.`;
     }
     const enabled = game.enabled();
-    const lastWords = last ? `Fired ${last.label}. ` : "";
-    if (enabled.length === 0) return `${lastWords}Nothing is enabled.`;
-    return `${lastWords}Enabled: ${enabled.map((t) => t.label).join(", ")}.`;
+    const lastWords = last ? `Fired: ${this.firingWords(last)}. ` : "";
+    if (enabled.length === 0) return `${lastWords}Nothing can fire.`;
+    return `${lastWords}Can fire: ${enabled.map((t) => this.firingWords(t)).join(", ")}.`;
+  }
+
+  /** A witness step (`start tc1`, `t1`) as the drawing says it: `start “Pick insert”`. */
+  stepWords(label: string): string {
+    const [kind, ...rest] = label.split(" ");
+    if ((kind === "start" || kind === "complete") && rest.length) return `${kind} ${this.nameOf(rest.join(" "))}`;
+    return this.nameOf(label);
+  }
+
+  /** A firing as the drawing says it: `start “Pick insert”`. */
+  firingWords(transition: NetTransition): string {
+    return transition.kind === "silent" ? this.nameOf(transition.task) : `${transition.kind} ${this.nameOf(transition.task)}`;
   }
 
   private render(): void {
