@@ -13,7 +13,7 @@ from django.shortcuts import redirect, render
 
 from hrc.cases.choices import OPEN_CASE_STATUSES
 from hrc.cases.selectors import supervised_cases, supervised_incidents
-from hrc.navigation import current_membership, page_url
+from hrc.navigation import current_membership
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership
 from hrc.organisations.selectors import cells_of
@@ -46,9 +46,4 @@ def _start_of(request: HttpRequest, membership: Membership) -> dict[str, Any]:
         .filter(case__organisation_id=organisation_id)
         .count(),
         "cell_count": cells_of(organisation_id).count(),
-        "start_case_url": page_url("cases:case-start", "/cases/new/"),
-        "people_url": page_url("organisation:people", "/organisation/people/"),
-        "teams_url": page_url("organisation:teams", "/organisation/teams/"),
-        "cells_url": page_url("organisation:cells", "/organisation/cells/"),
-        "cobot_new_url": page_url("cobots:cobot-new", "/cobots/new/"),
     }

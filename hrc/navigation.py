@@ -14,7 +14,7 @@ from typing import Any
 from django.contrib.auth.decorators import login_required
 from django.http import HttpRequest, HttpResponse, HttpResponseRedirect
 from django.shortcuts import render
-from django.urls import NoReverseMatch, Resolver404, resolve, reverse
+from django.urls import reverse
 from django.utils.functional import SimpleLazyObject
 from django.views.decorators.http import require_POST
 
@@ -64,23 +64,6 @@ class Navigation:
         return len(self.memberships) > 1
 
 
-def page_url(name: str, path: str) -> str | None:
-    """The URL of the page named `name`, else `path` if something serves it, else None.
-
-    Pages other parts of the project build are linked before they exist and
-    shown once they do, so no link leads to a 404.
-    """
-    try:
-        return reverse(name)
-    except NoReverseMatch:
-        pass
-    try:
-        resolve(path)
-    except Resolver404:
-        return None
-    return path
-
-
 # Administration is several pages (people, teams, cells); its link opens the first.
 ADMINISTRATION = "/organisation/"
 
@@ -106,9 +89,7 @@ def navigation_of(request: HttpRequest) -> Navigation:
             ("Cobots", reverse("cobots:cobot-list")),
         ]
         if role is Role.ADMIN:
-            links.append(
-                ("Administration", page_url("organisation:people", f"{ADMINISTRATION}people/"))
-            )
+            links.append(("Administration", reverse("organisation:people")))
     if request.user.is_superuser:
         links.append(("Site admin", reverse("admin:index")))
     current = _current_url(request.path, [url for _, url in links + cells if url])

@@ -45,7 +45,7 @@ class Refused(Exception):
 
 
 def _refusal(request: HttpRequest, refused: Refused) -> HttpResponse:
-    context = {"message": str(refused), "section": "analytics"}
+    context = {"message": str(refused)}
     return render(request, "cases/refused.html", context, status=refused.status)
 
 
@@ -55,9 +55,7 @@ def version_list(request: HttpRequest) -> HttpResponse:
     if not writable_organisations(request.user).exists():
         return _refusal(request, Refused(403, ANALYSTS_ONLY))
     versions = selectors.analysed_versions(request.user)
-    return render(
-        request, "analytics/version_list.html", {"versions": versions, "section": "analytics"}
-    )
+    return render(request, "analytics/version_list.html", {"versions": versions})
 
 
 @login_required
@@ -83,7 +81,6 @@ def version_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "filtered": bool(window),
         "xes_url": f"{reverse('analytics-xes')}?{urlencode(xes_query)}",
         "api_url": reverse("analytics-version", args=[version.pk]),
-        "section": "analytics",
     }
     return render(request, "analytics/version_detail.html", context)
 
@@ -106,7 +103,6 @@ def case_gantt(request: HttpRequest, pk: int) -> HttpResponse:
         "arrow_colours": ARROW_COLOURS,
         "xes_url": f"{reverse('analytics-xes')}?{urlencode({'case': case.pk})}",
         "api_url": reverse("analytics-case-gantt", args=[case.pk]),
-        "section": "analytics",
     }
     return render(request, "analytics/case_gantt.html", context)
 

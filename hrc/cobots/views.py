@@ -70,7 +70,7 @@ def cobot_list(request: HttpRequest) -> HttpResponse:
         {"cobot": cobot, "state": state, "queue": queues[cobot.pk]}
         for cobot, state in zip(cobots, states, strict=True)
     ]
-    return render(request, "cobots/cobot_list.html", {"rows": rows, "section": "cobots"})
+    return render(request, "cobots/cobot_list.html", {"rows": rows})
 
 
 @login_required
@@ -94,7 +94,6 @@ def cobot_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "problems": problems,
         "commands": commands,
         "buttons": [{"command": c, "path": p, "label": label} for c, p, label in BUTTONS],
-        "section": "cobots",
         "script": _script(cobot),
     }
     return render(request, "cobots/cobot_detail.html", context)
@@ -117,7 +116,7 @@ def cobot_new(request: HttpRequest) -> HttpResponse:
             _record(cobot, request.user, AdminAction.COBOT_REGISTERED, form.cleaned_data)
             return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
     status = 400 if form.errors else 200
-    context = {"form": form, "cobot": None, "section": "cobots"}
+    context = {"form": form, "cobot": None}
     return render(request, "cobots/cobot_form.html", context, status=status)
 
 
@@ -146,7 +145,7 @@ def cobot_edit(request: HttpRequest, pk: int) -> HttpResponse:
             _record(cobot, request.user, AdminAction.COBOT_CHANGED, changes)
             return HttpResponseRedirect(reverse("cobots:cobot-detail", args=[cobot.pk]))
     status = 400 if form.errors else 200
-    context = {"form": form, "cobot": cobot, "tested": tested, "section": "cobots"}
+    context = {"form": form, "cobot": cobot, "tested": tested}
     return render(request, "cobots/cobot_form.html", context, status=status)
 
 

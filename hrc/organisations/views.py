@@ -57,7 +57,6 @@ def _page(
     context |= {
         "organisation": organisation,
         "records": selectors.admin_records_of(organisation.pk)[:RECORDS_SHOWN],
-        "section": "organisation",
         "page": template.rsplit("/", 1)[-1].removesuffix(".html"),
     }
     return render(request, template, context, status=status)
