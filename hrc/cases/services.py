@@ -879,25 +879,26 @@ def record_event(
 
 
 def hand_back_work_items(user: User, organisation_id: int, by: User | None) -> int:
-    """Gives every open operator task `user` holds in the organisation back to its candidates
-    (claimed and started alike: they are leaving), each with an event in its case's log.
-    Returns how many went back. Registered with hrc.organisations.hooks for deactivation.
+    """Gives every task `user` has claimed in the organisation and not started back to its
+    candidates, each with an event in its case's log; returns how many went back.
+
+    A started task stays with them, as reassign_work_item keeps it: its start has fired
+    in the case's net, so it cannot be offered afresh; the case page names it and a
+    supervisor hands it to whoever finishes it. Registered with hrc.organisations.hooks
+    for deactivation.
     """
     held = WorkItem.objects.filter(
         case__organisation_id=organisation_id,
         claimed_by=user,
         kind=WorkItemKind.OPERATOR,
-        state__in=[WorkItemState.CLAIMED, WorkItemState.RUNNING],
+        state=WorkItemState.CLAIMED,
     ).values_list("pk", "case_id")
     handed_back = 0
     for item_id, case_id in list(held):
         with transaction.atomic():
             case = lock_case(case_id)
             item = WorkItem.objects.get(pk=item_id)
-            if item.claimed_by_id != user.pk or item.state not in (
-                WorkItemState.CLAIMED,
-                WorkItemState.RUNNING,
-            ):
+            if item.claimed_by_id != user.pk or item.state != WorkItemState.CLAIMED:
                 continue  # moved on before the lock
             item.state, item.claimed_by = WorkItemState.OFFERED, None
             item.save(update_fields=["state", "claimed_by"])

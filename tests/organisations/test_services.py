@@ -95,7 +95,7 @@ def test_selectors_see_only_the_users_own_organisations(
 # Deactivation hands the person's tasks back ---------------------------------------
 
 
-def test_deactivating_an_operator_gives_their_claimed_and_started_tasks_back(
+def test_deactivating_an_operator_gives_their_claimed_tasks_back_and_leaves_started_ones_to_hand_over(
     organisation: Organisation, engineer: User, operator: User, admin: User
 ) -> None:
     version = factories.make_version(organisation, published_by=engineer)
@@ -107,13 +107,20 @@ def test_deactivating_an_operator_gives_their_claimed_and_started_tasks_back(
 
     handed_back = services.deactivate_member(Membership.objects.get(user=operator), by=admin)
 
-    assert handed_back == 2
-    for item in (claimed, started):
-        item = WorkItem.objects.get(pk=item.pk)
-        assert item.state == WorkItemState.OFFERED
-        assert item.claimed_by is None
-        event = CaseEvent.objects.filter(case_id=item.case_id, type=EventType.TASK_REASSIGNED).get()  # fmt: skip
-        assert event.user == admin
+    assert handed_back == 1
+    item = WorkItem.objects.get(pk=claimed.pk)
+    assert item.state == WorkItemState.OFFERED
+    assert item.claimed_by is None
+    event = CaseEvent.objects.filter(case_id=item.case_id, type=EventType.TASK_REASSIGNED).get()  # fmt: skip
+    assert event.user == admin
+    # Its start has fired in the net: it waits, held, for a supervisor to hand it over.
+    running = WorkItem.objects.get(pk=started.pk)
+    assert (running.state, running.claimed_by) == (WorkItemState.RUNNING, operator)
+    colleague = factories.make_member(organisation, Role.OPERATOR)
+    running.candidates.add(colleague)
+    case_services.reassign_work_item(running, by=engineer, to=colleague)
+    running.refresh_from_db()
+    assert (running.state, running.claimed_by) == (WorkItemState.RUNNING, colleague)
 
 
 def test_a_person_deactivated_here_but_active_elsewhere_cannot_claim_work_here(
