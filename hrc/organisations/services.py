@@ -279,7 +279,7 @@ def set_member_teams(membership: Membership, teams: Iterable[Team], *, by: User)
 
 @transaction.atomic
 def deactivate_member(membership: Membership, *, by: User) -> int:
-    """Ends the person's work in the organisation and gives back the tasks they hold.
+    """Ends the person's work in the organisation and gives back the tasks they claimed.
 
     The membership stays (the record and the case logs name them) but no longer
     counts; they leave its teams. A user with no other active membership can no

@@ -50,6 +50,14 @@ OBJECT_ENDPOINTS = [
     Endpoint("get", "/api/patterns/{pattern}/export/?format=pnml", write=False),
     Endpoint("get", "/api/pattern-versions/{version}/", write=False),
     Endpoint("get", "/api/pattern-versions/{version}/export/", write=False),
+    Endpoint(
+        "put",
+        "/api/pattern-versions/{version}/start-rights/",
+        write=True,
+        body={"roles": ["operator"], "cells": []},
+    ),
+    Endpoint("post", "/api/pattern-versions/{version}/retire/", write=True, body={"on": True}),
+    Endpoint("post", "/api/patterns/{pattern}/archive/", write=True, body={"on": True}),
     Endpoint("get", "/api/cobots/{cobot}/", write=False),
     Endpoint("put", "/api/cobots/{cobot}/", write=True, body=COBOT_BODY),
     Endpoint("patch", "/api/cobots/{cobot}/", write=True, body={"name": "overwritten"}),
@@ -118,6 +126,9 @@ class World:
         assert self.pattern.name == "Hand-over"
         assert self.cobot.name == "cobot1"
         assert list(self.pattern.versions.values_list("number", flat=True)) == [1]
+        assert self.pattern.archived_at is None
+        self.version.refresh_from_db()
+        assert (self.version.retired_at, self.version.start_roles) == (None, ["admin", "engineer"])
 
 
 @pytest.fixture
