@@ -46,7 +46,7 @@ class Refused(Exception):
 
 def _refusal(request: HttpRequest, refused: Refused) -> HttpResponse:
     context = {"message": str(refused)}
-    return render(request, "cases/refused.html", context, status=refused.status)
+    return render(request, "refused.html", context, status=refused.status)
 
 
 @login_required

@@ -76,7 +76,7 @@ class Refused(Exception):
 
 
 def _refusal(request: HttpRequest, refused: Refused) -> HttpResponse:
-    return render(request, "cases/refused.html", {"message": str(refused)}, status=refused.status)
+    return render(request, "refused.html", {"message": str(refused)}, status=refused.status)
 
 
 # Running cases -----------------------------------------------------------------------------

@@ -51,7 +51,7 @@ BUTTONS = [
 
 
 def _refused(request: HttpRequest, status: int, message: str) -> HttpResponse:
-    return render(request, "cases/refused.html", {"message": message}, status=status)
+    return render(request, "refused.html", {"message": message}, status=status)
 
 
 @login_required

@@ -63,7 +63,7 @@ def _page(
 
 
 def _refused(request: HttpRequest) -> HttpResponse:
-    return render(request, "cases/refused.html", {"message": ADMINS_ONLY}, status=403)
+    return render(request, "refused.html", {"message": ADMINS_ONLY}, status=403)
 
 
 def admins_only(view: Any) -> Any:

@@ -136,4 +136,4 @@ def _editor(request: HttpRequest, config: dict[str, Any], title: str) -> HttpRes
 
 
 def _refused(request: HttpRequest, status: int, message: str) -> HttpResponse:
-    return render(request, "patterns/refused.html", {"message": message}, status=status)
+    return render(request, "refused.html", {"message": message}, status=status)
