@@ -217,6 +217,11 @@ class Command(BaseCommand):
 
 
 def _interrupt(signum: int, frame: FrameType | None) -> None:
+    # The first signal stops the demo; any that follows (make passes SIGTERM on to its
+    # group, a second Ctrl-C) is ignored from here on, not only once the `finally` runs:
+    # one arriving in between would cut the stopping short and leave orphans.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise KeyboardInterrupt
 
 
