@@ -2,7 +2,7 @@
 
 The forms only turn what a person chose into the services' input (an actor
 mapping, start data); the services check it (hrc.cases.mapping, start_cases)
-and a refusal comes back to the field it names (`Invalid.field`).
+and a refusal comes back to the fields it names (`Invalid.fields`).
 """
 
 import json
