@@ -29,7 +29,7 @@ from hrc.live.selectors import Access
 from hrc.navigation import current_membership
 from hrc.organisations.selectors import cells_of
 from hrc.patterns.models import PatternVersion
-from hrc.patterns.selectors import versions_startable_at, why_may_not_start
+from hrc.patterns.selectors import versions_startable_at
 
 
 @login_required
@@ -38,14 +38,8 @@ def tablet(request: HttpRequest, cell: str = "") -> HttpResponse:
     access = _access(request)
     if not selectors.is_cell(access.organisation_id, cell):
         return _unknown_cell(request, access, cell)
-    config = {
-        "organisation": access.organisation_id,
-        "cell": cell,
-        "user": access.user_id,
-        "socket": f"/ws/live/?organisation={access.organisation_id}&cell={cell}",
-    }
     context = {
-        "config": config,
+        "config": _config(access, cell),
         "cell": cell,
         "cycles": _cycles(request, access, cell) if cell else [],
         "started": request.GET.get("started", ""),
@@ -84,13 +78,12 @@ def start_cycle(request: HttpRequest, cell: str, version: str) -> HttpResponse:
         (v, form if v.pk == chosen.pk else _cycle_form(v))
         for v in _startable(request, access, cell).values()
     ]
-    config = {
-        "organisation": access.organisation_id,
+    context = {
+        "config": _config(access, cell),
         "cell": cell,
-        "user": access.user_id,
-        "socket": f"/ws/live/?organisation={access.organisation_id}&cell={cell}",
+        "cycles": cycles,
+        "refused": chosen.pk,
     }
-    context = {"config": config, "cell": cell, "cycles": cycles, "refused": chosen.pk}
     return render(request, "tablet/tablet.html", context, status=400)
 
 
@@ -108,6 +101,16 @@ def _access(request: HttpRequest) -> Access:
     return access
 
 
+def _config(access: Access, cell: str) -> dict[str, Any]:
+    """What the tablet script needs: whose tablet, which cell, where its live socket is."""
+    return {
+        "organisation": access.organisation_id,
+        "cell": cell,
+        "user": access.user_id,
+        "socket": f"/ws/live/?organisation={access.organisation_id}&cell={cell}",
+    }
+
+
 def _unknown_cell(request: HttpRequest, access: Access, cell: str) -> HttpResponse:
     context = {
         "cell": cell,
@@ -122,7 +125,6 @@ def _startable(request: HttpRequest, access: Access, cell: str) -> dict[int, Pat
         version.pk: version
         for version in versions_startable_at(request.user, cell)
         if version.pattern.organisation_id == access.organisation_id
-        and why_may_not_start(request.user, version, cell=cell) is None
     }
 
 
