@@ -15,6 +15,13 @@ from django.utils.dateparse import parse_date, parse_datetime
 from hrc.analytics.xes import LIFECYCLES, Lifecycle
 
 ID = re.compile(r"[0-9]{1,18}")  # fits a bigint primary key
+# Real zones lie within UTC-12 and UTC+14; PostgreSQL refuses an offset past ±15:59, which
+# Python accepts up to ±23:59, so a wider one would fail only inside the query.
+MAX_OFFSET = dt.timedelta(hours=14)
+# A day inside either end keeps the value, and any offset added to it, within the years
+# both Python and the databases hold.
+EARLIEST = dt.datetime(1, 1, 2, tzinfo=dt.UTC)
+LATEST = dt.datetime(9999, 12, 30, tzinfo=dt.UTC)
 
 
 class BadParameter(ValueError):
@@ -43,7 +50,20 @@ def moment(name: str, value: str | None) -> dt.datetime | None:
             f"{name} must be a date and time in ISO 8601, such as 2025-03-01T08:00:00Z "
             f"or 2025-03-01, not {value[:40]!r}.",
         )
-    return timezone.make_aware(parsed) if timezone.is_naive(parsed) else parsed
+    aware = timezone.make_aware(parsed) if timezone.is_naive(parsed) else parsed
+    offset = aware.utcoffset() or dt.timedelta()
+    if abs(offset) > MAX_OFFSET:
+        raise BadParameter(
+            name, f"{name} has the UTC offset {_hours(offset)}; offsets lie within -14:00 and +14:00."
+        )
+    if not EARLIEST <= aware <= LATEST:
+        raise BadParameter(name, f"{name} must lie between 0001-01-02 and 9999-12-30, not {value[:40]!r}.")
+    return aware
+
+
+def _hours(offset: dt.timedelta) -> str:
+    minutes = int(abs(offset).total_seconds()) // 60
+    return f"{'-' if offset < dt.timedelta() else '+'}{minutes // 60:02d}:{minutes % 60:02d}"
 
 
 def window(

@@ -52,3 +52,36 @@ def test_under_asgi_batches_are_pulled_one_at_a_time() -> None:
     assert taken_after_first == ASYNC_BATCH
     assert len(parts) == 3
     assert b"".join(parts) == "".join(str(n) for n in range(chunks.total)).encode()
+
+
+def failing_after(count: int, closed: list[bool]) -> Iterator[str]:
+    try:
+        for n in range(count):
+            yield str(n)
+        raise RuntimeError("the database refused the query")
+    finally:
+        closed.append(True)
+
+
+def test_a_stream_that_fails_under_wsgi_ends_its_body_and_closes_its_source() -> None:
+    closed: list[bool] = []
+    response = streamed(
+        RequestFactory().get("/"), failing_after(2, closed), content_type="text/plain", filename="x"
+    )
+    assert list(response.streaming_content) == [b"0", b"1"]  # type: ignore[arg-type]  # sync here
+    assert closed == [True]
+
+
+def test_a_stream_that_fails_under_asgi_ends_its_body_and_closes_its_source() -> None:
+    closed: list[bool] = []
+    response = streamed(
+        AsyncRequestFactory().get("/"), failing_after(3, closed), content_type="text/plain", filename="x"
+    )
+
+    async def whole() -> list[bytes]:
+        return [part async for part in response.streaming_content]  # type: ignore[union-attr]
+
+    with ThreadPoolExecutor(1) as thread:
+        parts = thread.submit(asyncio.run, whole()).result()
+    assert b"".join(parts) == b"012"
+    assert closed == [True]

@@ -122,6 +122,9 @@ def test_since_and_until_keep_the_cases_that_started_between(
         ("?since=yesterday", "since", "since must be a date and time in ISO 8601"),
         ("?until=2025-13-01", "until", "until must be a date and time"),
         ("?since=2025-03-02&until=2025-03-01", "until", "until must come after since"),
+        ("?since=2026-01-01T00:00:00%2B23:08", "since", "the UTC offset +23:08"),
+        ("?until=2026-01-01T00:00:00-15:00", "until", "offsets lie within -14:00 and +14:00"),
+        ("?until=9999-12-31T23:00:00-05:00", "until", "must lie between"),
     ],
 )
 def test_a_bad_window_is_a_400_that_names_the_parameter(
