@@ -15,6 +15,7 @@ from typing import Any
 import psycopg
 import pytest
 from django.conf import settings
+from django.db import connection
 
 from hrc.cobots.gateway.launcher import free_port
 from tests.cases.test_run_pattern_embedded import ROOT, embedded_environment
@@ -147,3 +148,11 @@ def test_a_postgresql_server_that_does_not_answer_is_named_at_once(tmp_path: Pat
     [line] = result.stderr.strip().splitlines()
     assert "Cannot open the postgresql database hrc (connection failed:" in line
     assert "Connection refused" in line
+
+
+@pytest.mark.django_db
+def test_no_statement_on_postgresql_runs_longer_than_the_timeout() -> None:
+    with connection.cursor() as cursor:
+        cursor.execute("SHOW statement_timeout")
+        [(timeout,)] = cursor.fetchall()
+    assert timeout == "30s"

@@ -84,7 +84,12 @@ if DATABASE_URL:
         # per request (~3 ms of two processes' CPU). With the health checks on, the
         # pool checks a connection as it is taken: one that a database restart broke
         # is replaced, not handed out.
-        DATABASES["default"].setdefault("OPTIONS", {})["pool"] = {
+        options = DATABASES["default"].setdefault("OPTIONS", {})
+        # No statement may hold a connection longer than this, whatever a request asks for:
+        # the pool has few connections, and one stuck query per request would drain it.
+        timeout_ms = int(float(env_str("HRC_DB_STATEMENT_TIMEOUT") or 30) * 1000)
+        options["options"] = f"-c statement_timeout={timeout_ms}"
+        options["pool"] = {
             "min_size": 1,
             "max_size": int(env_str("HRC_DB_POOL_SIZE") or 10),
             # How long a request waits for a free connection before it answers 503.
