@@ -3,10 +3,9 @@
 from django.contrib import admin
 from django.urls import include, path, re_path
 from drf_spectacular.views import SpectacularAPIView, SpectacularRedocView, SpectacularSwaggerView
-from rest_framework.authtoken.views import obtain_auth_token
 
 from hrc import home, navigation
-from hrc.api.views import api_not_found
+from hrc.api.views import TokenView, api_not_found
 
 urlpatterns = [
     # Sends each role to its place: operators to their tablet (also after sign-in).
@@ -33,7 +32,7 @@ urlpatterns = [
         name="api-redoc",
     ),
     # Machines trade a username and password for a token once, then send `Authorization: Token …`.
-    path("api/token/", obtain_auth_token, name="api-token"),
+    path("api/token/", TokenView.as_view(), name="api-token"),
     # Sign-in for the browsable API (session auth), so a person can try it from the browser.
     path("api/auth/", include("rest_framework.urls")),
     path("api/", include("hrc.api.urls")),

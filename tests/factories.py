@@ -34,6 +34,12 @@ def make_user(username: str | None = None) -> User:
     )
 
 
+def api_key(user: User) -> str:
+    """A fresh API key for `user`, as POST /api/token/ would give."""
+    key, _ = organisation_services.issue_api_token(user)
+    return key
+
+
 def make_organisation(name: str | None = None) -> Organisation:
     number = next(_serial)
     return organisation_services.create_organisation(

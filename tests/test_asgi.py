@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 from django.contrib.auth.models import User
-from rest_framework.authtoken.models import Token
 
+from tests import factories
 from tests.live.server import LiveServer
 from tests.postgres import sessions_opened
 
@@ -20,7 +20,7 @@ def test_requests_share_the_pools_database_sessions(tmp_path: Path, operator: Us
     # Under ASGI each request runs on a thread of its own: with persistent connections
     # (CONN_MAX_AGE) instead of the pool, each would open a session of its own.
     server = LiveServer(tmp_path / "server.log").start()
-    token = Token.objects.create(user=operator).key
+    token = factories.api_key(operator)
     request = urllib.request.Request(
         f"{server.url}/api/organisations/", headers={"Authorization": f"Token {token}"}
     )

@@ -54,10 +54,13 @@ def moment(name: str, value: str | None) -> dt.datetime | None:
     offset = aware.utcoffset() or dt.timedelta()
     if abs(offset) > MAX_OFFSET:
         raise BadParameter(
-            name, f"{name} has the UTC offset {_hours(offset)}; offsets lie within -14:00 and +14:00."
+            name,
+            f"{name} has the UTC offset {_hours(offset)}; offsets lie within -14:00 and +14:00.",
         )
     if not EARLIEST <= aware <= LATEST:
-        raise BadParameter(name, f"{name} must lie between 0001-01-02 and 9999-12-30, not {value[:40]!r}.")
+        raise BadParameter(
+            name, f"{name} must lie between 0001-01-02 and 9999-12-30, not {value[:40]!r}."
+        )
     return aware
 
 

@@ -1,4 +1,5 @@
-"""The API's root (/api/), listing its endpoints, and its answer for an address it lacks."""
+"""The API's root (/api/), listing its endpoints, its answer for an address it lacks, and
+the door for machines: API keys."""
 
 from typing import Any
 
@@ -13,13 +14,23 @@ from django.urls import (
     reverse,
 )
 from drf_spectacular.utils import extend_schema
+from rest_framework import serializers
+from rest_framework.authtoken.serializers import AuthTokenSerializer
+from rest_framework.exceptions import Throttled, ValidationError
 from rest_framework.permissions import AllowAny
 from rest_framework.request import Request
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
+from hrc.organisations import services
+
 # The API's own documents, served beside it in hrc/urls.py.
 DOCUMENTS = {"schema": "api-schema", "docs": "api-docs", "redoc": "api-redoc", "token": "api-token"}
+
+
+class ApiKeySerializer(serializers.Serializer[Any]):
+    token = serializers.CharField(help_text="The key; only its digest is kept, so keep it safe.")
+    expires_at = serializers.DateTimeField(help_text="From then on the key is refused.")
 
 
 class ApiRootView(APIView):
@@ -74,3 +85,33 @@ def api_not_found(request: HttpRequest, *args: Any, **kwargs: Any) -> JsonRespon
     if not request.path.endswith("/") and _serves(request.path + "/"):
         detail += f" Did you mean {request.path}/?"
     return JsonResponse({"detail": f"{detail} The endpoints are listed at /api/."}, status=404)
+
+
+class LockedOut(Throttled):
+    default_detail = (
+        "Too many wrong passwords from this address; sign-in is locked for a while. "
+        "Try again later, or ask an admin."
+    )
+
+
+class TokenView(APIView):
+    """`POST /api/token/` with `username` and `password`: a new API key, shown once."""
+
+    authentication_classes: list[type] = []  # credentials in the body, not a session
+    permission_classes = [AllowAny]
+    serializer_class = AuthTokenSerializer
+
+    @extend_schema(request=AuthTokenSerializer, responses={200: ApiKeySerializer})
+    def post(self, request: Request) -> Response:
+        """A new key for `Authorization: Token <key>`, valid until `expires_at`; every key of
+        the user stops working when their password changes or their membership ends. Ten
+        wrong passwords from one address lock it out (429) for a while (hrc.signin)."""
+        serializer = AuthTokenSerializer(data=request.data, context={"request": request})
+        valid = serializer.is_valid()
+        # axes marks the request it was given, DRF's, where its middleware cannot see it.
+        if getattr(request, "axes_locked_out", False):
+            raise LockedOut()
+        if not valid:
+            raise ValidationError(serializer.errors)
+        key, token = services.issue_api_token(serializer.validated_data["user"])
+        return Response(ApiKeySerializer({"token": key, "expires_at": token.expires_at}).data)

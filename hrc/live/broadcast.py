@@ -54,6 +54,8 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 CHANNEL_MESSAGE_TYPE = "live.events"
+# To a user's sockets: their membership of the message's organisation ended.
+MEMBERSHIP_ENDED_TYPE = "membership.ended"
 # How long flush() waits for the sender by default.
 FLUSH_TIMEOUT = 10.0
 # The sender keeps its database connection (for the cobot queues) while it is busy.
@@ -100,6 +102,12 @@ def send_event_on_commit(
     """
     send = _Send(list(groups), organisation, [event], [cell])
     transaction.on_commit(lambda: _sender().put(send))
+
+
+def membership_ended_on_commit(user_id: int, organisation_id: int) -> None:
+    """Closes, after commit, the user's sockets on the organisation: at once, not on the
+    consumers' next membership check."""
+    transaction.on_commit(lambda: _sender().put(_MembershipEnded(user_id, organisation_id)))
 
 
 def cobot_queue_on_commit(cobot_id: int) -> None:
@@ -253,11 +261,17 @@ class _QueueChanged:
 
 
 @dataclass
+class _MembershipEnded:
+    user_id: int
+    organisation: int
+
+
+@dataclass
 class _Flush:
     done: threading.Event = field(default_factory=threading.Event)
 
 
-_Work = _Send | _QueueChanged | _Flush
+_Work = _Send | _QueueChanged | _MembershipEnded | _Flush
 
 
 class _Sender:
@@ -315,6 +329,9 @@ class _Sender:
             sends += _queue_sends(changed)
         if sends:
             _run_on_layer(_group_send_all(sends), loop)
+        ended = [work for work in batch if isinstance(work, _MembershipEnded)]
+        if ended:
+            _run_on_layer(_send_membership_ended(ended), loop)
 
 
 def _queue_sends(cobot_ids: list[int]) -> list[_Send]:
@@ -335,6 +352,15 @@ async def _group_send_all(sends: list[_Send]) -> None:
         message = send.message()
         for group in send.groups:
             await layer.group_send(group, message)
+
+
+async def _send_membership_ended(ended: list[_MembershipEnded]) -> None:
+    layer = get_channel_layer()
+    if layer is None:
+        return
+    for work in ended:
+        message = {"type": MEMBERSHIP_ENDED_TYPE, "organisation": work.organisation}
+        await layer.group_send(user_group(work.user_id), message)
 
 
 def _merged(sends: list[_Send]) -> list[_Send]:

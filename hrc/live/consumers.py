@@ -7,10 +7,12 @@ none of the organisation's; then the socket joins its
 groups and only then reads the snapshot (hrc.live.events explains why). Each
 event type has its handler; every send first re-checks that the event is the
 organisation's and the cell's, and that the user's membership still holds.
-Memberships are read again every RECHECK_SECONDS for all the process's
-sockets in one query (Memberships), not per socket and send: 200 tablets
-would otherwise queue 200 reads in front of one delta. A socket whose
-membership is gone is refused and closed. `cobot-state` deltas are
+An admin who ends a membership closes the user's sockets at once (a
+`membership.ended` message to the user's group); as a backstop, memberships
+are read again every RECHECK_SECONDS for all the process's sockets in one
+query (Memberships), not per socket and send: 200 tablets would otherwise
+queue 200 reads in front of one delta. A socket whose membership is gone is
+refused and closed. `cobot-state` deltas are
 coalesced: at most one frame per STATE_INTERVAL per socket.
 """
 
@@ -111,6 +113,11 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             await self.send(text_data=message["text"])
         elif forwarded:
             await self.send_json(forwarded)
+
+    async def membership_ended(self, message: dict[str, Any]) -> None:
+        """An admin ended the user's membership (broadcast.membership_ended_on_commit)."""
+        if self._organisation_matches(message):
+            await self.revoke()
 
     # One handler per event type: True sends it now.
 

@@ -3,8 +3,9 @@
 Imports point inwards: cases imports organisations, never the other way. Yet
 when an admin deactivates a person, the tasks that person holds must go back
 to their team, and only the cases app knows them; before a cell is deleted,
-only the cobots app knows who stands in it. Each registers its answer in its
-AppConfig.ready() (hrc.cases.apps, hrc.cobots.apps); nothing registered means
+only the cobots app knows who stands in it; when a membership ends, only the
+live app knows the person's open sockets. Each registers its answer in its
+AppConfig.ready() (hrc.cases.apps, hrc.cobots.apps, hrc.live.apps); nothing registered means
 nothing held and nobody standing there.
 """
 
@@ -18,11 +19,15 @@ from django.contrib.auth.models import User
 # returns how many went back.
 HandBack = Callable[[User, int, User | None], int]
 
+# Tells the user's (id) open connections that their membership of the organisation (id) ended.
+MembershipEnded = Callable[[int, int], None]
+
 # The names of the cobots standing in the organisation's (id) cell of that name.
 Occupants = Callable[[int, str], list[str]]
 
 _HAND_BACK: list[HandBack] = []
 _OCCUPANTS: list[Occupants] = []
+_ENDED: list[MembershipEnded] = []
 
 
 def register_member_leaving(hand_back: HandBack) -> None:
@@ -45,3 +50,15 @@ def register_cell_occupants(occupants: Occupants) -> None:
 def cell_occupants(organisation_id: int, cell: str) -> list[str]:
     """Every registered app's names of what stands in the cell, sorted."""
     return sorted(name for occupants in _OCCUPANTS for name in occupants(organisation_id, cell))
+
+
+def register_membership_ended(ended: MembershipEnded) -> None:
+    """Called once by the app that holds people's live connections, from its AppConfig.ready()."""
+    if ended not in _ENDED:
+        _ENDED.append(ended)
+
+
+def membership_ended(user_id: int, organisation_id: int) -> None:
+    """Tells every registered app that the user is no longer a member of the organisation."""
+    for ended in _ENDED:
+        ended(user_id, organisation_id)

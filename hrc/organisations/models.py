@@ -167,3 +167,26 @@ class AdminRecord(models.Model):
 
     def __str__(self) -> str:
         return f"{self.get_action_display()} {self.target}"
+
+
+class ApiToken(models.Model):
+    """A machine's key to the API, kept only as its SHA-256: a database dump holds no usable key.
+
+    A key is 40 random characters, so a fast hash is as safe as a slow one and costs
+    one indexed lookup per request. Each `POST /api/token/` issues a new one; all a
+    user's go when their password changes, when they are deactivated and when they
+    leave an organisation (hrc.organisations.services).
+    """
+
+    digest = models.CharField(max_length=64, unique=True, help_text="SHA-256 of the key, in hex.")
+    user = models.ForeignKey(
+        settings.AUTH_USER_MODEL, on_delete=models.CASCADE, related_name="api_tokens"
+    )
+    created_at = models.DateTimeField(auto_now_add=True)
+    expires_at = models.DateTimeField(help_text="The key is refused from then on.")
+
+    class Meta:
+        ordering = ["-created_at"]
+
+    def __str__(self) -> str:
+        return f"API token of {self.user} until {self.expires_at:%Y-%m-%d %H:%M}"

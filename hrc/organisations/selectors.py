@@ -5,9 +5,10 @@ Functions take any user, signed in or not: an anonymous user belongs nowhere.
 
 from django.contrib.auth.models import AbstractBaseUser, AnonymousUser
 from django.db.models import QuerySet
+from django.utils import timezone
 
 from hrc.organisations.choices import WRITER_ROLES, Role
-from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation, Team
+from hrc.organisations.models import AdminRecord, ApiToken, Cell, Membership, Organisation, Team
 
 AnyUser = AbstractBaseUser | AnonymousUser
 
@@ -89,4 +90,13 @@ def admin_organisations_of(user: AnyUser) -> QuerySet[Organisation]:
         return Organisation.objects.none()
     return Organisation.objects.filter(
         memberships__user_id=user.pk, memberships__role=Role.ADMIN, memberships__is_active=True
+    )
+
+
+def api_token_of(digest: str) -> ApiToken | None:
+    """The live (unexpired) token with this digest, with its user; one query."""
+    return (
+        ApiToken.objects.select_related("user")
+        .filter(digest=digest, expires_at__gt=timezone.now())
+        .first()
     )

@@ -5,21 +5,36 @@ saves, so the API, the admin and the management commands share one set of
 checks; a broken rule raises django.core.exceptions.ValidationError.
 """
 
+import hashlib
 import secrets
 from collections.abc import Iterable, Mapping
+from datetime import timedelta
 from typing import Any
 
+from django.conf import settings
 from django.contrib.auth import get_user_model
 from django.contrib.auth.models import User
 from django.contrib.auth.tokens import default_token_generator
 from django.core.exceptions import ValidationError
 from django.db import transaction
+from django.utils import timezone
 from django.utils.encoding import force_bytes
 from django.utils.http import urlsafe_base64_encode
 
 from hrc.organisations import hooks
 from hrc.organisations.choices import AdminAction, Role
-from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation, Team
+from hrc.organisations.models import (
+    AdminRecord,
+    ApiToken,
+    Cell,
+    Membership,
+    Organisation,
+    Team,
+)
+
+# A script that asks for a key on every run would otherwise pile them up; past this many
+# live ones, issuing another retires the oldest.
+API_TOKENS_PER_USER = 20
 
 
 def create_organisation(*, name: str, slug: str) -> Organisation:
@@ -65,8 +80,44 @@ def change_role(membership: Membership, role: Role | str) -> Membership:
 
 
 def remove_member(membership: Membership) -> None:
-    """Takes the user out of the organisation (and so out of its teams)."""
+    """Takes the user out of the organisation (and so out of its teams); their API keys go
+    and their live sockets in it close (hooks.membership_ended)."""
+    user, organisation_id = membership.user, membership.organisation_id
     membership.delete()
+    revoke_api_tokens(user)
+    hooks.membership_ended(user.pk, organisation_id)
+
+
+def digest_of(key: str) -> str:
+    """How an API key is stored and looked up."""
+    return hashlib.sha256(key.encode()).hexdigest()
+
+
+def issue_api_token(user: User) -> tuple[str, ApiToken]:
+    """A new API key for `user` (shown once: only its digest is kept) and its row; expired
+    keys of the user are forgotten, and the oldest live ones past API_TOKENS_PER_USER."""
+    key = secrets.token_urlsafe(30)  # 40 characters
+    now = timezone.now()
+    lifetime = timedelta(hours=settings.HRC_API_TOKEN_HOURS)
+    with transaction.atomic():
+        ApiToken.objects.filter(user=user, expires_at__lte=now).delete()
+        kept = ApiToken.objects.filter(user=user).values_list("pk", flat=True)
+        ApiToken.objects.filter(pk__in=list(kept[API_TOKENS_PER_USER - 1 :])).delete()
+        token = ApiToken.objects.create(user=user, digest=digest_of(key), expires_at=now + lifetime)
+    return key, token
+
+
+def revoke_api_tokens_on_new_password(sender: type[User], instance: User, **kwargs: Any) -> None:
+    """post_save of a user: set_password() leaves the new raw password on the instance
+    until the save is over, so its presence says the password just changed."""
+    if getattr(instance, "_password", None) is not None:
+        revoke_api_tokens(instance)
+
+
+def revoke_api_tokens(user: User) -> int:
+    """Every API key of `user` stops working at once; returns how many there were."""
+    deleted, _ = ApiToken.objects.filter(user=user).delete()
+    return deleted
 
 
 def create_team(organisation: Organisation, *, name: str) -> Team:
@@ -297,6 +348,8 @@ def deactivate_member(membership: Membership, *, by: User) -> int:
         user.is_active = False
         user.save(update_fields=["is_active"])
     handed_back = hooks.hand_back_work(user, membership.organisation_id, by)
+    revoke_api_tokens(user)
+    hooks.membership_ended(user.pk, membership.organisation_id)
     record_admin_action(
         membership.organisation, by, AdminAction.PERSON_DEACTIVATED, user.username,
         {"tasks_handed_back": handed_back, "signs_in": user.is_active},

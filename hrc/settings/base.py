@@ -30,11 +30,12 @@ INSTALLED_APPS = [
     "django.contrib.messages",
     "django.contrib.staticfiles",
     "rest_framework",
-    "rest_framework.authtoken",
     "drf_spectacular",
     # Swagger UI and ReDoc as static files: /api/docs/ needs no CDN.
     "drf_spectacular_sidecar",
     "channels",
+    # Login lockout on every path that signs in (hrc.signin says why this and how).
+    "axes",
     "hrc.organisations",
     "hrc.patterns",
     "hrc.cobots",
@@ -52,6 +53,8 @@ MIDDLEWARE = [
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
     "hrc.middleware.DatabaseUnavailableMiddleware",
+    # Last, as axes asks: it turns a lockout into its 429 page.
+    "axes.middleware.AxesMiddleware",
 ]
 
 ROOT_URLCONF = "hrc.urls"
@@ -157,6 +160,29 @@ CELERY_BROKER_CONNECTION_RETRY_ON_STARTUP = True
 CELERY_DB_REUSE_MAX = 10_000
 CELERY_WORKER_HIJACK_ROOT_LOGGER = False
 
+AUTHENTICATION_BACKENDS = [
+    # First: refuses a locked-out address before any password is compared.
+    "hrc.signin.LockoutBackend",
+    "django.contrib.auth.backends.ModelBackend",
+]
+AXES_FAILURE_LIMIT = int(env_str("HRC_LOGIN_FAILURE_LIMIT") or 10)
+AXES_LOCKOUT_PARAMETERS = ["ip_address"]
+AXES_COOLOFF_TIME = "hrc.signin.cool_off"
+AXES_ENABLE_ACCESS_FAILURE_LOG = True  # the lockouts that lengthen the next cool-off
+AXES_RESET_ON_SUCCESS = False
+AXES_LOCKOUT_TEMPLATE = (
+    "registration/locked_out.html"  # one known password must not reset the count for others
+)
+# Behind a reverse proxy (Caddy) the client's address is the proxies' last hop in
+# X-Forwarded-For; without one, that header is the client's own word and is ignored.
+HRC_PROXY_COUNT = int(env_str("HRC_PROXY_COUNT") or 0)
+AXES_IPWARE_PROXY_COUNT = HRC_PROXY_COUNT or None
+AXES_IPWARE_META_PRECEDENCE_ORDER = (
+    ["HTTP_X_FORWARDED_FOR", "REMOTE_ADDR"] if HRC_PROXY_COUNT else ["REMOTE_ADDR"]
+)
+# API keys (hrc.organisations.models.ApiToken) last this many hours.
+HRC_API_TOKEN_HOURS = float(env_str("HRC_API_TOKEN_HOURS") or 24 * 7)
+
 AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.UserAttributeSimilarityValidator"},
     {"NAME": "django.contrib.auth.password_validation.MinimumLengthValidator"},
@@ -185,7 +211,7 @@ REST_FRAMEWORK = {
     # Token first: a machine without valid credentials gets 401 with
     # `WWW-Authenticate: Token`, which tells an integrator what to send.
     "DEFAULT_AUTHENTICATION_CLASSES": [
-        "rest_framework.authentication.TokenAuthentication",
+        "hrc.api.authentication.ApiTokenAuthentication",
         "rest_framework.authentication.SessionAuthentication",
     ],
     # Size- and depth-limited JSON everywhere, so no view can forget it.

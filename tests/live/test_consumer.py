@@ -192,6 +192,34 @@ def test_a_member_who_leaves_the_organisation_is_cut_off(
     run(scenario())
 
 
+@pytest.mark.parametrize("ending", ["deactivated", "removed"])
+def test_a_member_an_admin_lets_go_is_cut_off_at_once_not_at_the_next_check(
+    server: LiveServer, operator: User, admin: User, organisation: Organisation, ending: str
+) -> None:
+    cookie = session_cookie(operator)
+    membership = Membership.objects.get(user=operator, organisation=organisation)
+
+    def let_go() -> None:
+        if ending == "deactivated":
+            organisation_services.deactivate_member(membership, by=admin)
+        else:
+            organisation_services.remove_member(membership)
+
+    async def scenario() -> None:
+        socket = await open_socket(server, cookie)
+        assert (await receive(socket))["type"] == "snapshot"
+        await db(let_go)
+        # Well before the periodic check would have noticed.
+        refused = await receive_until(
+            socket, lambda e: e["type"] == "refused", timeout=RECHECK_SECONDS - 3
+        )
+        assert "no longer a member" in refused["reason"]
+        with pytest.raises(ConnectionClosed):
+            await receive(socket, timeout=5)
+
+    run(scenario())
+
+
 def test_a_cell_tablet_gets_the_case_deltas_too(
     server: LiveServer, operator: User, choice_case: Case, organisation: Organisation
 ) -> None:
