@@ -40,7 +40,7 @@ def cool_off(request: HttpRequest | None = None) -> timedelta:
     address = getattr(request, "axes_ip_address", None)
     if not address:
         return FIRST_COOL_OFF
-    failures = AccessFailureLog.objects.filter(
+    failures: int = AccessFailureLog.objects.filter(
         ip_address=address, attempt_time__gte=timezone.now() - MEMORY
     ).count()
     limit: int = settings.AXES_FAILURE_LIMIT

@@ -75,7 +75,10 @@ def test_a_stream_that_fails_under_wsgi_ends_its_body_and_closes_its_source() ->
 def test_a_stream_that_fails_under_asgi_ends_its_body_and_closes_its_source() -> None:
     closed: list[bool] = []
     response = streamed(
-        AsyncRequestFactory().get("/"), failing_after(3, closed), content_type="text/plain", filename="x"
+        AsyncRequestFactory().get("/"),
+        failing_after(3, closed),
+        content_type="text/plain",
+        filename="x",
     )
 
     async def whole() -> list[bytes]:
