@@ -37,6 +37,7 @@ from django.utils import timezone
 
 from hrc.cases import dispatch, services
 from hrc.cases.choices import (
+    OPEN_CASE_STATUSES,
     CaseStatus,
     EventType,
     IncidentKind,
@@ -359,7 +360,7 @@ def finish_job(
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
         job.accepted_at = accepted_at or job.started_at
         job.save(update_fields=["state", "result", "ended_at", "accepted_at"])
-        if case.status in (CaseStatus.RUNNING, CaseStatus.SUSPENDED):
+        if case.status in OPEN_CASE_STATUSES:
             services.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
         _ring_for_next_on_commit(job)
@@ -381,6 +382,8 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
         if job is None:
             return
         job.last_error, job.accepted_at = str(error), accepted_at
+        if _ended_with_case(case, job):
+            return
         item = job.work_item
         if isinstance(error, CobotPaused):
             # Not sent, and nothing a retry would change: back in the queue, which waits for
@@ -420,6 +423,20 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
             services.open_incident(case, kind, str(error), item=item, cobot_state=error.state)
             _ring_for_next_on_commit(job)  # the cobot's next job may go
         case.save()
+
+
+def _ended_with_case(case: Case, job: Job) -> bool:
+    """A running job whose case ended meanwhile (cancelled, failed) ends too: cancelled, never
+    queued again, where it would stay listed for ever. True when it did.
+
+    Call while holding the case row lock."""
+    if case.status in OPEN_CASE_STATUSES:
+        return False
+    job.state, job.ended_at = JobState.CANCELLED, timezone.now()
+    job.save()
+    live.cobot_queue_on_commit(job.cobot_id)
+    _ring_for_next_on_commit(job)
+    return True
 
 
 def _backoff(retries_used: int) -> float:
@@ -500,6 +517,8 @@ def _expire_lease(job_id: int, case_id: int) -> None:
             or job.lease_expires_at is None
             or job.lease_expires_at >= timezone.now()
         ):
+            return
+        if _ended_with_case(case, job):
             return
         job.lease_expiries += 1
         if job.lease_expiries >= MAX_LEASE_EXPIRIES:

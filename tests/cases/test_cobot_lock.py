@@ -21,9 +21,10 @@ from django.db import connection, connections, transaction
 from django.utils import timezone
 
 from hrc.cases import jobs
+from hrc.cases import services as case_services
 from hrc.cases.choices import JobState
 from hrc.cases.launcher import RedisProcess
-from hrc.cases.models import Job
+from hrc.cases.models import Case, Job
 from hrc.celery import app
 from hrc.cobots.choices import CommandOutcome, ControlCommand
 from hrc.cobots.models import Cobot, CobotCommand
@@ -166,3 +167,21 @@ def test_no_job_is_leased_while_a_persons_command_to_the_cobot_is_under_way(
     command.outcome, command.finished_at = CommandOutcome.OK, timezone.now()
     command.save()
     assert jobs.lease_next_job(cobot.pk) is not None
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_cancelled_cases_job_whose_lease_expires_ends_with_the_case_not_back_in_the_queue(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    cobot = _two_jobs_queued_on_one_cobot(organisation, engineer, operator)
+    lease = jobs.lease_next_job(cobot.pk)
+    assert lease is not None
+    case_services.cancel_case(Case.objects.get(pk=lease.case_id), by=engineer)
+    # The worker that held the step died: its lease runs out.
+    Job.objects.filter(pk=lease.job_id).update(lease_expires_at=timezone.now())
+
+    jobs.sweep()
+
+    job = Job.objects.get(pk=lease.job_id)
+    assert job.state == JobState.CANCELLED
+    assert job.ended_at is not None
