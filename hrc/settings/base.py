@@ -160,6 +160,13 @@ CELERY_BROKER_CONNECTION_RETRY_ON_STARTUP = True
 CELERY_DB_REUSE_MAX = 10_000
 CELERY_WORKER_HIJACK_ROOT_LOGGER = False
 
+LOGGING = {
+    "version": 1,
+    "disable_existing_loggers": False,
+    "filters": {"publish_chatter": {"()": "hrc.logfilters.PublishChatterToDebug"}},
+    "loggers": {"asyncua.common.subscription": {"filters": ["publish_chatter"]}},
+}
+
 AUTHENTICATION_BACKENDS = [
     # First: refuses a locked-out address before any password is compared.
     "hrc.signin.LockoutBackend",
