@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import urllib.error
 import urllib.request
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 from django.contrib.auth.models import User
 
+from hrc.organisations.models import Organisation
 from tests import factories
 from tests.live.server import LiveServer
 from tests.postgres import sessions_opened
@@ -34,3 +37,46 @@ def test_requests_share_the_pools_database_sessions(tmp_path: Path, operator: Us
     finally:
         server.stop()
     assert opened <= 2  # the pool's own, counted late, and perhaps one more it keeps ready
+
+
+# The probe's requests that once held a connection, a worker thread or the CPU.
+HOSTILE = [
+    ("GET", "/api/analytics/xes/?version={version}&since=2026-01-01T00:00:00%2B23:00", None),
+    ("GET", "/api/analytics/xes/?version={version}&until=2026-01-01T00:00:00%2B23:08", None),
+    ("GET", "/api/patterns/?limit=9223372036854775808", None),
+    ("GET", "/api/cases/?limit=99999999999999999999&offset=-1", None),
+    ("POST", "/api/work-items/%C2%B2/claim/", b"{}"),
+    ("POST", "/api/cells/stop/", b'{"cell": ""}'),
+]
+HOSTILE_REQUESTS = 50
+
+
+@pytest.mark.django_db(transaction=True)
+def test_after_fifty_hostile_requests_at_once_the_server_still_answers(
+    tmp_path: Path, engineer: User, organisation: Organisation
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer)
+    key = factories.api_key(engineer)
+    headers = {"Authorization": f"Token {key}", "Content-Type": "application/json"}
+    server = LiveServer(tmp_path / "server.log").start(bare=True)
+
+    def hostile(n: int) -> int:
+        method, path, body = HOSTILE[n % len(HOSTILE)]
+        url = f"{server.url}{path.format(version=version.pk)}"
+        request = urllib.request.Request(url, body, headers, method=method)
+        try:
+            with urllib.request.urlopen(request, timeout=60) as response:
+                response.read()
+                return int(response.status)
+        except urllib.error.HTTPError as refused:
+            return refused.code
+
+    try:
+        with ThreadPoolExecutor(HOSTILE_REQUESTS) as pool:
+            answers = list(pool.map(hostile, range(HOSTILE_REQUESTS)))
+        plain = urllib.request.Request(f"{server.url}/api/organisations/", headers=headers)
+        with urllib.request.urlopen(plain, timeout=1) as response:
+            assert response.status == 200
+    finally:
+        server.stop()
+    assert all(answer < 500 for answer in answers), answers
