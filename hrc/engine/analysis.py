@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Literal
 
-from hrc.engine.budget import Budget, Deadline
+from hrc.engine.budget import NO_TIME_LIMIT, Budget, Deadline
 from hrc.engine.graph import reachable
 from hrc.engine.petri import Marking, Net
 from hrc.engine.reduction import ReducedNet, reduce_net
@@ -77,7 +77,9 @@ class _Explorer:
     refer to those numbers.
     """
 
-    def __init__(self, net: Net, reduced: ReducedNet, max_markings: int, deadline: Deadline) -> None:
+    def __init__(
+        self, net: Net, reduced: ReducedNet, max_markings: int, deadline: Deadline
+    ) -> None:
         self.net = net
         self.reduced = reduced
         self.max_markings = max_markings
@@ -220,7 +222,7 @@ class _Explorer:
         return Fault(kind, self.marking(self.order[number]), self.path(number))
 
 
-def analyse(net: Net, budget: Budget = Budget(), deadline: Deadline | None = None) -> Analysis:
+def analyse(net: Net, budget: Budget = NO_TIME_LIMIT, deadline: Deadline | None = None) -> Analysis:
     """Decides soundness and boundedness of an execution net within `budget`; see the module docstring.
 
     `deadline` is the one of a larger check that already started; by default

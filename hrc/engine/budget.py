@@ -38,6 +38,10 @@ class Budget:
         return Deadline(self.clock, end)
 
 
+NO_TIME_LIMIT = Budget()
+"""The default: DEFAULT_MAX_MARKINGS and no deadline (the command line, the runtime's own checks)."""
+
+
 @dataclass(frozen=True)
 class Deadline:
     clock: Clock

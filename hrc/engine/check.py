@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from hrc.engine.analysis import Analysis, Fault, analyse
-from hrc.engine.budget import Budget
+from hrc.engine.budget import NO_TIME_LIMIT, Budget
 from hrc.engine.classify import classification_issues, classify
 from hrc.engine.document import FormatError, read_pattern
 from hrc.engine.execution import build_execution_net, constraint_places
@@ -42,7 +42,7 @@ class CheckReport:
         }
 
 
-def check_document(data: object, budget: Budget = Budget()) -> CheckReport:
+def check_document(data: object, budget: Budget = NO_TIME_LIMIT) -> CheckReport:
     """Checks a parsed `hrc-pattern/1` document; a shape problem gives a report, not an exception."""
     try:
         pattern = read_pattern(data)
@@ -51,7 +51,7 @@ def check_document(data: object, budget: Budget = Budget()) -> CheckReport:
     return check_pattern(pattern, budget)
 
 
-def check_pattern(pattern: Pattern, budget: Budget = Budget()) -> CheckReport:
+def check_pattern(pattern: Pattern, budget: Budget = NO_TIME_LIMIT) -> CheckReport:
     """The whole check; soundness is decided within `budget`, whose time starts now.
 
     The phases before the analysis are linear in the size of the document
@@ -74,9 +74,7 @@ def check_pattern(pattern: Pattern, budget: Budget = Budget()) -> CheckReport:
     return CheckReport(not errors, classification.patterns, sound, errors, warnings, stats)
 
 
-def _analysis_issues(
-    pattern: Pattern, net: Net, analysis: Analysis, budget: Budget
-) -> list[Issue]:
+def _analysis_issues(pattern: Pattern, net: Net, analysis: Analysis, budget: Budget) -> list[Issue]:
     explain = _Explainer(pattern, net)
     issues = [explain.fault(fault) for fault in analysis.faults if fault.kind != "dead"]
     dead = [fault for fault in analysis.faults if fault.kind == "dead"]

@@ -139,9 +139,9 @@ class Pattern:
     @cached_property
     def _process_by_node(self) -> dict[str, Process]:
         return _first_by_id(
-            (node.id, process)
+            (node_id, process)
             for process in self.processes
-            for node in (*process.places, *process.transitions)
+            for node_id in (*(p.id for p in process.places), *(t.id for t in process.transitions))
         )
 
 
