@@ -5,9 +5,12 @@ markings are explored breadth first, so the first marking found with a
 fault is one at the end of a shortest firing sequence, and that sequence,
 expanded back into the original firings, is the witness shown to the
 engineer (shortest up to the steps the reduction takes at once: a chain of
-firings that nothing can interrupt is shown whole). Exploration stops at `max_markings`; whatever was found by then is
-reported, and a verdict that needs the whole space becomes "too large to
-decide" instead of a hang.
+firings that nothing can interrupt is shown whole).
+
+Exploration stops at the budget's `max_markings` or its deadline (see
+`budget`), and so do the phases after it that walk every marking; whatever
+was found by then is reported, and a verdict that needs the whole space
+becomes "too large to decide" instead of a hang.
 """
 
 from collections import Counter, deque
@@ -15,13 +18,17 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Literal
 
+from hrc.engine.budget import NO_TIME_LIMIT, Budget, Deadline
 from hrc.engine.graph import reachable
 from hrc.engine.petri import Marking, Net
 from hrc.engine.reduction import ReducedNet, reduce_net
 
-DEFAULT_MAX_MARKINGS = 200_000
-
 FaultKind = Literal["deadlock", "livelock", "improper", "dead", "unbounded"]
+Limit = Literal["markings", "time"]
+
+# Phases that walk every marking look at the clock this often (a clock read
+# costs about as much as looking at one marking).
+_CLOCK_EVERY = 1024
 
 _State = tuple[int, ...]
 
@@ -46,10 +53,12 @@ class Fault:
 @dataclass(frozen=True)
 class Analysis:
     decided: bool
-    """False when exploration hit the cap before every fault kind could be ruled out."""
+    """False when the budget ran out before every fault kind could be ruled out."""
     faults: tuple[Fault, ...]
     stats: dict[str, int]
     """Sizes of the net, of the reduced net, and `markings`: how many were explored."""
+    stopped_by: Limit | None = None
+    """Which limit of the budget left the verdict undecided; None when decided."""
 
     @property
     def sound(self) -> bool | None:
@@ -68,10 +77,14 @@ class _Explorer:
     refer to those numbers.
     """
 
-    def __init__(self, net: Net, reduced: ReducedNet, max_markings: int) -> None:
+    def __init__(
+        self, net: Net, reduced: ReducedNet, max_markings: int, deadline: Deadline
+    ) -> None:
         self.net = net
         self.reduced = reduced
         self.max_markings = max_markings
+        self.deadline = deadline
+        self.stopped_by: Limit | None = None
         self.index = {place: i for i, place in enumerate(reduced.places)}
         self.pre = [self._tokens(t.pre) for t in reduced.transitions]
         self.post = [self._tokens(t.post) for t in reduced.transitions]
@@ -84,6 +97,7 @@ class _Explorer:
                 self.consumers[pre[0]].append(t)
         self.ignored = {self.index[p] for p in net.ignored if p in self.index}
         self.final = self._state(net.final)
+        self.final_counts = Counter(self.final)
         self.cyclic = _has_cycle(reduced)
         self.ids: dict[_State, int] = {}
         self.order: list[_State] = []
@@ -124,10 +138,17 @@ class _Explorer:
         return number
 
     def explore(self) -> bool:
-        """Fills `order`, `parent` and `edges`; False when the cap stopped it early."""
+        """Fills `order`, `parent` and `edges`; False when the budget stopped it early.
+
+        The clock is read once per marking expanded: the cover test of a
+        cyclic net walks every ancestor, so one expansion can cost far more
+        than `_CLOCK_EVERY` plain markings.
+        """
         queue = deque([self._add(self._state(self.net.initial), None)])
         while queue:
             number = queue.popleft()
+            if self.deadline.passed():
+                return self._stop("time", expanded=number)
             out = self.edges[number]
             for t, successor in self.successors(self.order[number]):
                 known = self.ids.get(successor)
@@ -141,10 +162,21 @@ class _Explorer:
                     if self.unbounded is not None:
                         return True  # An unbounded space has no end: what else it holds is moot.
                 if len(self.order) >= self.max_markings:
-                    self.expanded = number + 1
-                    return False
+                    return self._stop("markings", expanded=number + 1)
                 queue.append(found)
         self.expanded = len(self.order)
+        return True
+
+    def _stop(self, limit: Limit, expanded: int) -> bool:
+        self.stopped_by = limit
+        self.expanded = expanded
+        return False
+
+    def out_of_time(self, step: int) -> bool:
+        """For the phases after exploration: whether the deadline has passed, looked at every so often."""
+        if step % _CLOCK_EVERY or not self.deadline.passed():
+            return False
+        self.stopped_by = "time"
         return True
 
     def _covering(self, number: int) -> Fault | None:
@@ -154,8 +186,9 @@ class _Explorer:
         link = self.parent[number]
         while link is not None:
             ancestor, _ = link
-            smaller = Counter(self.order[ancestor])
-            if len(self.order[ancestor]) < len(state) and smaller <= counts:
+            # Fewer tokens first: it is cheap and rules out most ancestors of a bounded net.
+            fewer = len(self.order[ancestor]) < len(state)
+            if fewer and (smaller := Counter(self.order[ancestor])) <= counts:
                 grown = next(i for i in counts if counts[i] > smaller[i])
                 prefix = self.path(ancestor)
                 return Fault(
@@ -183,23 +216,28 @@ class _Explorer:
 
     def is_improper(self, state: _State) -> bool:
         """The end is marked but something else (apart from constraint places) still is too."""
-        return Counter(self.final) <= Counter(state) and not self.is_final(state)
+        return self.final_counts <= Counter(state) and not self.is_final(state)
 
     def fault(self, kind: FaultKind, number: int) -> Fault:
         return Fault(kind, self.marking(self.order[number]), self.path(number))
 
 
-def analyse(net: Net, max_markings: int = DEFAULT_MAX_MARKINGS) -> Analysis:
-    """Decides soundness and boundedness of an execution net; see the module docstring."""
+def analyse(net: Net, budget: Budget = NO_TIME_LIMIT, deadline: Deadline | None = None) -> Analysis:
+    """Decides soundness and boundedness of an execution net within `budget`; see the module docstring.
+
+    `deadline` is the one of a larger check that already started; by default
+    the budget's time starts now.
+    """
+    deadline = deadline or budget.start()
     reduced = reduce_net(net)
-    explorer = _Explorer(net, reduced, max_markings)
-    complete = explorer.explore()
+    explorer = _Explorer(net, reduced, budget.max_markings, deadline)
+    explorer.explore()
     faults: list[Fault] = []
     if explorer.unbounded is not None:
         faults.append(explorer.unbounded)
     else:
         faults.extend(_local_faults(explorer))
-        if complete:
+        if explorer.stopped_by is None:
             faults.extend(_global_faults(explorer))
     stats = {
         "net_places": len(net.places),
@@ -208,16 +246,20 @@ def analyse(net: Net, max_markings: int = DEFAULT_MAX_MARKINGS) -> Analysis:
         "reduced_transitions": len(reduced.transitions),
         "markings": len(explorer.order),
     }
-    return Analysis(complete, tuple(faults), stats)
+    decided = explorer.stopped_by is None
+    return Analysis(decided, tuple(faults), stats, explorer.stopped_by)
 
 
 def _local_faults(explorer: _Explorer) -> Iterator[Fault]:
     """Faults one marking shows: the first deadlock and the first improper end, in BFS order.
 
     Only expanded markings count: past the cap, "no successor" would be a lie.
+    Past the deadline, the first faults among the markings looked at so far.
     """
     deadlock = improper = None
     for number in range(explorer.expanded):
+        if explorer.out_of_time(number):
+            break
         state = explorer.order[number]
         if explorer.is_improper(state):
             improper = number if improper is None else improper
@@ -230,14 +272,24 @@ def _local_faults(explorer: _Explorer) -> Iterator[Fault]:
 
 
 def _global_faults(explorer: _Explorer) -> Iterator[Fault]:
-    """Faults that need the whole space: no way to the end (livelock), transitions that never fire."""
+    """Faults that need the whole space: no way to the end (livelock), transitions that never fire.
+
+    Nothing when the deadline passes first (`explorer.stopped_by` says so): a
+    livelock or a dead transition found in part of the space is no finding.
+    """
     reverse: dict[int, list[int]] = {number: [] for number in range(len(explorer.order))}
     for number, out in enumerate(explorer.edges):
+        if explorer.out_of_time(number):
+            return
         for _, successor in out:
             reverse[successor].append(number)
     numbers = range(len(explorer.order))
     can_finish = reachable([n for n in numbers if explorer.is_final(explorer.order[n])], reverse)
+    if explorer.out_of_time(0):
+        return
     can_end = reachable([n for n in numbers if not explorer.edges[n]], reverse)
+    if explorer.out_of_time(0):
+        return
     # A livelock: the case runs on but can neither finish nor even get stuck.
     looping = next((n for n in numbers if n not in can_finish and n not in can_end), None)
     if looping is not None:

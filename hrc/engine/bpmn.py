@@ -175,7 +175,8 @@ def _bpmn(element: ET.Element) -> str | None:
 
 
 def _children(element: ET.Element, local: str) -> list[ET.Element]:
-    return [child for child in element if child.tag == f"{{{BPMN_NAMESPACE}}}{local}"]
+    tag = f"{{{BPMN_NAMESPACE}}}{local}"
+    return [child for child in element if child.tag == tag]
 
 
 def _hrc(element: ET.Element, name: str) -> str | None:

@@ -7,7 +7,8 @@ and publishing all call, so every one of them gives the same answer.
 from dataclasses import dataclass, field
 from typing import Any
 
-from hrc.engine.analysis import DEFAULT_MAX_MARKINGS, Analysis, Fault, analyse
+from hrc.engine.analysis import Analysis, Fault, analyse
+from hrc.engine.budget import NO_TIME_LIMIT, Budget
 from hrc.engine.classify import classification_issues, classify
 from hrc.engine.document import FormatError, read_pattern
 from hrc.engine.execution import build_execution_net, constraint_places
@@ -41,16 +42,22 @@ class CheckReport:
         }
 
 
-def check_document(data: object, max_markings: int = DEFAULT_MAX_MARKINGS) -> CheckReport:
+def check_document(data: object, budget: Budget = NO_TIME_LIMIT) -> CheckReport:
     """Checks a parsed `hrc-pattern/1` document; a shape problem gives a report, not an exception."""
     try:
         pattern = read_pattern(data)
     except FormatError as exc:
         return CheckReport(False, (), None, tuple(exc.issues), ())
-    return check_pattern(pattern, max_markings)
+    return check_pattern(pattern, budget)
 
 
-def check_pattern(pattern: Pattern, max_markings: int = DEFAULT_MAX_MARKINGS) -> CheckReport:
+def check_pattern(pattern: Pattern, budget: Budget = NO_TIME_LIMIT) -> CheckReport:
+    """The whole check; soundness is decided within `budget`, whose time starts now.
+
+    The phases before the analysis are linear in the size of the document
+    (whose size the caller bounds), so only the analysis reads the clock.
+    """
+    deadline = budget.start()
     issues = check_rules(pattern)
     classification = classify(pattern)
     issues += classification_issues(pattern, classification)
@@ -59,30 +66,37 @@ def check_pattern(pattern: Pattern, max_markings: int = DEFAULT_MAX_MARKINGS) ->
     stats: dict[str, int] = {}
     if not any(issue.code in STRUCTURAL_CODES for issue in issues):
         net = build_execution_net(pattern)
-        analysis = analyse(net, max_markings)
-        issues += _analysis_issues(pattern, net, analysis)
+        analysis = analyse(net, budget, deadline)
+        issues += _analysis_issues(pattern, net, analysis, budget)
         sound, stats = analysis.sound, analysis.stats
     errors = tuple(i for i in issues if i.severity == "error")
     warnings = tuple(i for i in issues if i.severity == "warning")
     return CheckReport(not errors, classification.patterns, sound, errors, warnings, stats)
 
 
-def _analysis_issues(pattern: Pattern, net: Net, analysis: Analysis) -> list[Issue]:
+def _analysis_issues(pattern: Pattern, net: Net, analysis: Analysis, budget: Budget) -> list[Issue]:
     explain = _Explainer(pattern, net)
     issues = [explain.fault(fault) for fault in analysis.faults if fault.kind != "dead"]
     dead = [fault for fault in analysis.faults if fault.kind == "dead"]
     if dead:
         issues.append(explain.dead(dead))
     if not analysis.decided and not analysis.faults:
-        issues.append(
-            warning(
-                "state-space-too-large",
-                f"The model is too large to decide: {analysis.stats['markings']} markings were explored "
-                "without finding a fault, and the check stops there. Split it into smaller "
-                "patterns or reduce the parallel branches.",
-            )
-        )
+        issues.append(_too_large(analysis, budget))
     return issues
+
+
+def _too_large(analysis: Analysis, budget: Budget) -> Issue:
+    """The warning of an undecided check, naming the limit it ran into."""
+    markings = analysis.stats["markings"]
+    if analysis.stopped_by == "time" and budget.seconds is not None:
+        limit = f"too large to decide in {budget.seconds:g} s: {markings} markings were explored"
+    else:
+        limit = f"too large to decide: {markings} markings were explored"
+    return warning(
+        "state-space-too-large",
+        f"The model is {limit} without finding a fault, and the check stops there. Split it "
+        "into smaller patterns or reduce the parallel branches.",
+    )
 
 
 class _Explainer:

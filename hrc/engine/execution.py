@@ -103,8 +103,9 @@ def build_execution_net(pattern: Pattern) -> Net:
             final[sink] = final.get(sink, 0) + 1
         inputs: Arcs = defaultdict(list)
         outputs: Arcs = defaultdict(list)
+        transition_ids = {t.id for t in process.transitions}
         for source, target in process.arcs:
-            if any(t.id == target for t in process.transitions):
+            if target in transition_ids:
                 inputs[target].append((source, 1))
             else:
                 outputs[source].append((target, 1))

@@ -23,6 +23,8 @@ STRUCTURAL_CODES = (
 )
 # task-config: a task, guard or message configuration the runtime could not run (taskconfig.py).
 ERROR_CODES = (*STRUCTURAL_CODES, "task-config", "pattern-mismatch", "unsound", "unbounded")
+# state-space-too-large: soundness was not decided within the check's budget (budget.py), its
+# markings or its seconds; the message says which ("too large to decide in 2 s").
 WARNING_CODES = ("vacuous-pattern", "no-pattern", "state-space-too-large")
 CODES = (*ERROR_CODES, *WARNING_CODES)
 

@@ -72,6 +72,10 @@ SWEEPS = 4
 """Barycentre sweeps (alternately left to right and right to left)."""
 CONSTRAINT_SPAN = 2
 """Columns between the two tasks of a time constraint: a task, a place, a task."""
+# Each time constraint costs a search of the graph drawn so far (adding its span must not
+# close a cycle). Past this many nodes visited in all, the remaining constraints are drawn
+# without their span, so a document with thousands of them is laid out in bounded time.
+CONSTRAINT_SEARCH_STEPS = 1_000_000
 
 
 def lay_out(document: object) -> dict[str, Any]:
@@ -177,6 +181,7 @@ class _Plan:
         self._find_back_arcs()
         self.forward: dict[int, list[tuple[int, int]]] = defaultdict(list)
         """Acyclic edges with their minimum length in columns: net arcs and time constraints."""
+        self.search_steps = CONSTRAINT_SEARCH_STEPS
         self._build_forward_edges()
         self._assign_columns()
         self.null_lane = len(self.actors)
@@ -266,8 +271,12 @@ class _Plan:
                 self.forward[a].append((b, CONSTRAINT_SPAN))
 
     def _reaches(self, start: int, goal: int) -> bool:
+        """Whether `goal` can be reached from `start`; True, to be safe, once the steps are spent."""
         seen, stack = {start}, [start]
         while stack:
+            self.search_steps -= 1
+            if self.search_steps < 0:
+                return True
             node = stack.pop()
             if node == goal:
                 return True
@@ -339,10 +348,13 @@ class _Plan:
             ]
             for node in self.nodes
         }
-        columns = sorted({column for _, column in groups})
+        lanes_of: dict[int, list[int]] = defaultdict(list)
+        for lane, column in sorted(groups):
+            lanes_of[column].append(lane)
+        columns = sorted(lanes_of)
         for sweep in range(SWEEPS):
             for column in columns if sweep % 2 == 0 else reversed(columns):
-                for lane in sorted({lane for lane, c in groups if c == column}):
+                for lane in lanes_of[column]:
                     self._settle(groups[lane, column], neighbours)
 
     def _settle(self, members: list[int], neighbours: dict[int, list[int]]) -> None:

@@ -8,7 +8,8 @@ A coexistence pattern is the same shape with several processes.
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from functools import cached_property
+from typing import Any, Literal, TypeVar
 
 ActorType = Literal["cobot", "operator"]
 ConstraintType = Literal["time", "space", "func"]
@@ -109,7 +110,7 @@ class Pattern:
     extra: Extra = field(default_factory=dict, compare=False)
 
     def actor(self, actor_id: str) -> Actor | None:
-        return next((a for a in self.actors if a.id == actor_id), None)
+        return self._actor_by_id.get(actor_id)
 
     def transitions(self) -> Iterator[tuple[Process, Transition]]:
         for process in self.processes:
@@ -117,13 +118,38 @@ class Pattern:
                 yield process, transition
 
     def transition(self, transition_id: str) -> Transition | None:
-        return next((t for _, t in self.transitions() if t.id == transition_id), None)
+        return self._transition_by_id.get(transition_id)
 
     def process_of(self, node_id: str) -> Process | None:
         """The process whose net holds this place or transition; None if none does."""
-        for process in self.processes:
-            if any(p.id == node_id for p in process.places):
-                return process
-            if any(t.id == node_id for t in process.transitions):
-                return process
-        return None
+        return self._process_by_node.get(node_id)
+
+    # Indexes for the lookups above, which rules and wording make once per element:
+    # a linear search each time made a check quadratic in the size of the document.
+    # Where an id is used twice (a rule reports it), the first element wins.
+
+    @cached_property
+    def _actor_by_id(self) -> dict[str, Actor]:
+        return _first_by_id((a.id, a) for a in self.actors)
+
+    @cached_property
+    def _transition_by_id(self) -> dict[str, Transition]:
+        return _first_by_id((t.id, t) for _, t in self.transitions())
+
+    @cached_property
+    def _process_by_node(self) -> dict[str, Process]:
+        return _first_by_id(
+            (node_id, process)
+            for process in self.processes
+            for node_id in (*(p.id for p in process.places), *(t.id for t in process.transitions))
+        )
+
+
+Value = TypeVar("Value")
+
+
+def _first_by_id(pairs: Iterator[tuple[str, Value]]) -> dict[str, Value]:
+    index: dict[str, Value] = {}
+    for key, value in pairs:
+        index.setdefault(key, value)
+    return index

@@ -51,9 +51,9 @@ def _duplicate_ids(pattern: Pattern, names: Names) -> Iterable[Issue]:
 def _arcs(pattern: Pattern, names: Names) -> Iterable[Issue]:
     for process in pattern.processes:
         places = {p.id for p in process.places}
-        transitions = {t.id for t in process.transitions}
+        nodes = places | {t.id for t in process.transitions}
         for source, target in process.arcs:
-            unknown = [end for end in (source, target) if end not in places | transitions]
+            unknown = [end for end in (source, target) if end not in nodes]
             for end in unknown:
                 owner = pattern.process_of(end)
                 where = f"it belongs to process {owner.id}" if owner else "no such element exists"

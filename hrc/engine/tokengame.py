@@ -47,15 +47,22 @@ from hrc.engine.model import Pattern
 Json = dict[str, Any]
 
 
+_ConstraintKey = tuple[str, tuple[str, str] | frozenset[str]]
+
+
 def execution_net_json(pattern: Pattern) -> Json:
     """The execution net of a pattern whose structural rules hold (see execution.py)."""
     net = build_execution_net(pattern)
     performers = {t.id: t.performer for _, t in pattern.transitions()}
     constraints = constraint_places(pattern)
+    # The first constraint behind each constraint place, found once rather than per place.
+    index_of: dict[_ConstraintKey, int] = {}
+    for i, c in enumerate(pattern.constraints):
+        index_of.setdefault(_constraint_key(c.type, c.source, c.target), i)
     places = []
     for place in net.places:
         if place in constraints:
-            described = _constraint_place(pattern, constraints[place])
+            described = _constraint_place(pattern, constraints[place], index_of)
         elif place.startswith("running:"):
             task = place.split(":", 1)[1]
             described = {"label": f"{task} running", "kind": "busy", "of": task}
@@ -87,25 +94,26 @@ def execution_net_json(pattern: Pattern) -> Json:
     }
 
 
-def _constraint_place(pattern: Pattern, place: ConstraintPlace) -> Json:
+def _constraint_key(kind: str, source: str, target: str) -> _ConstraintKey:
+    """A time constraint is known by its ordered ends, a func one by its ends in either order."""
+    if kind == "time":
+        return kind, (source, target)
+    return kind, frozenset({source, target})
+
+
+def _constraint_place(
+    pattern: Pattern, place: ConstraintPlace, index_of: dict[_ConstraintKey, int]
+) -> Json:
     if place.kind == "time":
         label = f"{place.first} done, for {place.second}"
-        index = next(
-            i
-            for i, c in enumerate(pattern.constraints)
-            if c.type == "time" and (c.source, c.target) == (place.first, place.second)
-        )
+        index = index_of[_constraint_key("time", place.first, place.second)]
     else:
         label = (
             f"{place.first} running, for {place.second}"
             if place.kind == "func-start"
             else f"{place.first} done, for {place.second}"
         )
-        index = next(
-            i
-            for i, c in enumerate(pattern.constraints)
-            if c.type == "func" and {c.source, c.target} == {place.first, place.second}
-        )
+        index = index_of[_constraint_key("func", place.first, place.second)]
     constraint = pattern.constraints[index]
     return {
         "label": label,

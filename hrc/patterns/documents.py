@@ -31,6 +31,7 @@ from django.core.exceptions import ValidationError
 from hrc.engine import FORMAT, FormatError, check_document, read_pattern, write_pattern
 from hrc.engine.bpmn import bpmn_to_pattern, is_bpmn
 from hrc.engine.bpmn_export import pattern_to_bpmn
+from hrc.engine.budget import NO_TIME_LIMIT, Budget
 from hrc.engine.issues import Issue
 from hrc.engine.layout import is_laid_out, lay_out_pattern
 from hrc.engine.model import Pattern
@@ -54,9 +55,13 @@ def read_draft(document: object) -> Pattern:
     return read_pattern(document)
 
 
-def check_report(document: object) -> Report:
-    """The engine's full check of a document as JSON-ready data; never raises for bad input."""
-    return check_document(document).as_dict()
+def check_report(document: object, budget: Budget = NO_TIME_LIMIT) -> Report:
+    """The engine's full check of a document within `budget`, as JSON-ready data.
+
+    Never raises for bad input; see hrc.patterns.checking for the budgets of
+    requests and of publishing.
+    """
+    return check_document(document, budget).as_dict()
 
 
 def is_publishable(report: Report) -> bool:

@@ -22,6 +22,7 @@ from django.utils import timezone
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import cells_of
+from hrc.patterns.checking import publish_budget
 from hrc.patterns.documents import (
     Report,
     check_report,
@@ -122,17 +123,20 @@ def import_pattern(
 def publish_pattern(pattern: PatternModel, *, published_by: User) -> PatternVersion:
     """Publishes the pattern's current draft as its next version; raises PublishRefused.
 
+    The check runs within the publish budget (hrc.patterns.checking); the caller holds
+    one of the organisation's engine slots.
+
     The draft that is checked is the draft that is published, and concurrent
     publishes number 1, 2, 3… without gaps or collisions (the pattern row lock).
     """
     # The check may take seconds, and on the embedded SQLite a transaction holds the whole
     # database's write lock: check first, and again under the lock only if the draft changed.
     draft = PatternModel.objects.values_list("draft", flat=True).get(pk=pattern.pk)
-    report = check_report(draft)
+    report = check_report(draft, publish_budget())
     with transaction.atomic():
         locked = PatternModel.objects.select_for_update().get(pk=pattern.pk)
         if locked.draft != draft:
-            report = check_report(locked.draft)
+            report = check_report(locked.draft, publish_budget())
         if not is_publishable(report):
             raise PublishRefused(report)
         last = locked.versions.aggregate(last=Max("number"))["last"] or 0

@@ -1,1 +1,2 @@
-"""Background jobs of the patterns app: none; checks are fast enough to run in the request."""
+"""Background jobs of the patterns app: none; checks run in the request within a budget
+(hrc.patterns.checking says why)."""

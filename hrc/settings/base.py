@@ -265,3 +265,12 @@ CELERY_BEAT_SCHEDULE = {
     "sweep-jobs": {"task": "hrc.cases.tasks.sweep", "schedule": HRC_SWEEP_SECONDS},
     "purge-messages": {"task": "hrc.cases.tasks.purge_messages", "schedule": 600.0},
 }
+
+# Checks of patterns (hrc.patterns.checking). A check in a request decides soundness
+# within this many seconds and markings (about 1 kB each), publishing within the larger
+# pair; each organisation runs at most HRC_ENGINE_SLOTS engine requests at once.
+HRC_CHECK_SECONDS = float(env_str("HRC_CHECK_SECONDS") or 2.0)
+HRC_CHECK_MARKINGS = int(env_str("HRC_CHECK_MARKINGS") or 100_000)
+HRC_PUBLISH_CHECK_SECONDS = float(env_str("HRC_PUBLISH_CHECK_SECONDS") or 30.0)
+HRC_PUBLISH_CHECK_MARKINGS = int(env_str("HRC_PUBLISH_CHECK_MARKINGS") or 200_000)
+HRC_ENGINE_SLOTS = int(env_str("HRC_ENGINE_SLOTS") or 2)

@@ -4,6 +4,7 @@ from typing import Any
 
 from hrc.engine import check_document, read_pattern
 from hrc.engine.analysis import analyse
+from hrc.engine.budget import Budget
 from hrc.engine.execution import build_execution_net
 from hrc.engine.petri import Marking, Net, NetTransition
 from hrc.engine.reduction import reduce_net
@@ -126,11 +127,11 @@ def test_three_long_parallel_chains_reduce_to_a_handful_of_markings() -> None:
 
 def test_a_state_space_past_the_cap_is_too_large_to_decide_not_a_hang() -> None:
     pattern = read_pattern(two_lanes([]))
-    analysis = analyse(build_execution_net(pattern), max_markings=2)
+    analysis = analyse(build_execution_net(pattern), Budget(max_markings=2))
 
     assert analysis.decided is False
     assert analysis.sound is None
-    report = check_document(two_lanes([]), max_markings=2)
+    report = check_document(two_lanes([]), Budget(max_markings=2))
     assert [w.code for w in report.warnings if w.code == "state-space-too-large"] == [
         "state-space-too-large"
     ]

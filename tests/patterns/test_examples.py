@@ -8,6 +8,7 @@ from typing import Any
 import pytest
 
 from hrc.engine import check_document
+from hrc.patterns.checking import interactive_budget
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples"
 EXAMPLES = sorted(EXAMPLES_DIR.glob("*.json"))
@@ -79,3 +80,17 @@ def test_example_cites_its_thesis_section_and_name(path: Path) -> None:
 
     source = load(path)["source"]
     assert re.match(rf"thesis, section 4\.3\.[1-4], {thesis_name}\b", source), source
+
+
+@pytest.mark.parametrize(
+    "path", EXAMPLES + sorted((EXAMPLES_DIR / "use_cases").glob("*.json")), ids=lambda p: p.stem
+)
+def test_a_check_within_a_requests_budget_decides_each_example_as_an_unbounded_one_does(
+    path: Path,
+) -> None:
+    document = load(path)
+
+    bounded = check_document(document, interactive_budget())
+
+    assert bounded.sound is True
+    assert bounded.as_dict() == check_document(document).as_dict()

@@ -1,8 +1,10 @@
 """Patterns: CRUD of drafts, check, publish, versions, import and export; the editor's helpers.
 
 The editor's helpers (check-document, layout, execution-net) take an unsaved
-`hrc-pattern/1` document in the body and store nothing. Unlike check, they
-are for the people who edit patterns: engineers and admins.
+`hrc-pattern/1` document in the body and store nothing. They, check, import
+and publish are for the people who edit patterns, engineers and admins, and
+each holds one of the organisation's engine slots while the engine works
+(hrc.patterns.checking): a 429 when they are all taken.
 
 Every queryset starts from the selectors, which see only the user's
 organisations: an outsider gets 404, a user without membership an empty list.
@@ -10,6 +12,8 @@ organisations: an outsider gets 404, a user without membership an empty list.
 
 import json
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from django.db.models import QuerySet
@@ -24,6 +28,7 @@ from drf_spectacular.utils import (
 )
 from rest_framework import serializers, status, viewsets
 from rest_framework.decorators import action
+from rest_framework.exceptions import PermissionDenied, Throttled
 from rest_framework.request import Request
 from rest_framework.response import Response
 from rest_framework.views import APIView
@@ -38,6 +43,7 @@ from hrc.api.parsers import (
     read_body,
 )
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
+from hrc.organisations.selectors import writable_organisations
 from hrc.patterns import services
 from hrc.patterns.api.serializers import (
     CheckReportSerializer,
@@ -51,6 +57,7 @@ from hrc.patterns.api.serializers import (
     StartRightsSerializer,
     SwitchSerializer,
 )
+from hrc.patterns.checking import EngineBusy, engine_slot, interactive_budget
 from hrc.patterns.choices import DocumentFormat
 from hrc.patterns.documents import (
     FormatError,
@@ -96,6 +103,15 @@ EXPORT_RESPONSES = {
 DRAFT_WRITE_RESPONSES = {200: PatternSerializer, 400: DocumentErrorSerializer}
 
 
+class EditorsOfPatterns(MembersReadWritersWrite):
+    """MembersReadWritersWrite, whose refusal names the actions that are for editors only."""
+
+    message = (
+        "Only engineers and admins of the organisation may change, check, lay out, import "
+        "or publish patterns."
+    )
+
+
 class WritersOfThePattern(MembersReadWritersWrite):
     """MembersReadWritersWrite for a version, whose organisation is its pattern's."""
 
@@ -117,10 +133,8 @@ class WritersOfThePattern(MembersReadWritersWrite):
 class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     """Collaboration patterns of your organisations. Members read; engineers and admins write."""
 
-    permission_classes = [MembersReadWritersWrite]
+    permission_classes = [EditorsOfPatterns]
     content_negotiation_class = FormatParameterForViews
-    # POSTs that change nothing: operators may run them too.
-    read_actions = frozenset({"check"})
 
     def get_queryset(self) -> QuerySet[PatternModel]:
         return patterns_visible_to(self.request.user).order_by("name", "id")
@@ -165,8 +179,14 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     @extend_schema(request=None, responses={200: CheckReportSerializer})
     @action(detail=True, methods=["post"])
     def check(self, request: Request, pk: str | None = None) -> Response:
-        """Checks the draft with the engine: rules, pattern classification, soundness."""
-        return Response(check_report(self.get_object().draft))
+        """Checks the draft with the engine: rules, pattern classification, soundness.
+
+        Soundness is decided within a few seconds; past them the report says the
+        model is too large to decide (a `state-space-too-large` warning).
+        """
+        pattern = self.get_object()
+        with _engine_slot(pattern.organisation_id):
+            return Response(check_report(pattern.draft, interactive_budget()))
 
     @extend_schema(
         request=None, responses={201: PatternVersionSerializer, 400: PublishRefusedSerializer}
@@ -176,7 +196,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         """Publishes the draft as the next version; refused with the report unless valid and sound."""
         pattern = self.get_object()
         try:
-            version = services.publish_pattern(pattern, published_by=_user(request))
+            with _engine_slot(pattern.organisation_id):
+                version = services.publish_pattern(pattern, published_by=_user(request))
         except services.PublishRefused as exc:
             raise Rejected(
                 {
@@ -237,15 +258,16 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         if xml_body:
             default = DocumentFormat.BPMN if looks_like_bpmn(body) else DocumentFormat.PNML
         document_format = _format_param(request, default)
-        if document_format == DocumentFormat.PNML:
-            document: object = from_pnml(body)
-        elif document_format == DocumentFormat.BPMN:
-            document = from_bpmn(body)
-        else:
-            document = parse_json_body(body)
-        pattern = services.import_pattern(
-            organisation, document=document, created_by=_user(request)
-        )
+        with _engine_slot(organisation.pk):
+            if document_format == DocumentFormat.PNML:
+                document: object = from_pnml(body)
+            elif document_format == DocumentFormat.BPMN:
+                document = from_bpmn(body)
+            else:
+                document = parse_json_body(body)
+            pattern = services.import_pattern(
+                organisation, document=document, created_by=_user(request)
+            )
         return Response(PatternSerializer(pattern).data, status=status.HTTP_201_CREATED)
 
     @extend_schema(parameters=[FORMAT_PARAMETER], responses=EXPORT_RESPONSES)
@@ -269,7 +291,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         """
         document = request.data
         read_draft(document)  # a shape error is the request's fault: 400
-        return Response(check_report(document))
+        with _engine_slot(_editing_organisation(request)):
+            return Response(check_report(document, interactive_budget()))
 
     @extend_schema(
         request=DOCUMENT_REQUEST,
@@ -288,7 +311,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     @action(detail=False, methods=["post"])
     def layout(self, request: Request) -> Response:
         """Lays the document out: left to right by precedence, each actor's tasks in its lane."""
-        return Response(laid_out(request.data))
+        with _engine_slot(_editing_organisation(request)):
+            return Response(laid_out(request.data))
 
     @extend_schema(
         request=DOCUMENT_REQUEST,
@@ -312,7 +336,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         a structural rule has no execution net: 400 with the rules' issues.
         """
         try:
-            net = execution_net(request.data)
+            with _engine_slot(_editing_organisation(request)):
+                net = execution_net(request.data)
         except NoExecutionNet as exc:
             raise Rejected(
                 {
@@ -430,6 +455,27 @@ def _id_param(request: Request, name: str) -> int | None:
     if not ID_PATTERN.fullmatch(value):
         raise Rejected({"detail": f"{name} must be an id (a whole number)."})
     return int(value)
+
+
+@contextmanager
+def _engine_slot(organisation_id: int) -> Iterator[None]:
+    """One of the organisation's engine slots for the block; a 429 with Retry-After when none is free."""
+    try:
+        with engine_slot(organisation_id):
+            yield
+    except EngineBusy as exc:
+        raise Throttled(wait=exc.retry_after, detail=str(exc)) from None
+
+
+def _editing_organisation(request: Request) -> int:
+    """The organisation whose slots an unsaved document's engine work takes: the user's first
+    organisation with an editor's role (the permission has made sure there is one)."""
+    organisation_id: int | None = (
+        writable_organisations(request.user).order_by("pk").values_list("pk", flat=True).first()
+    )
+    if organisation_id is None:
+        raise PermissionDenied(EditorsOfPatterns.message)
+    return organisation_id
 
 
 def _user(request: Request) -> Any:
