@@ -51,6 +51,11 @@ def check_document(data: object, budget: Budget = NO_TIME_LIMIT) -> CheckReport:
     return check_pattern(pattern, budget)
 
 
+def report_of(data: object, budget: Budget = NO_TIME_LIMIT) -> dict[str, Any]:
+    """check_document's report as JSON-ready data: what an engine worker process returns."""
+    return check_document(data, budget).as_dict()
+
+
 def check_pattern(pattern: Pattern, budget: Budget = NO_TIME_LIMIT) -> CheckReport:
     """The whole check; soundness is decided within `budget`, whose time starts now.
 

@@ -7,7 +7,6 @@ the engine's interface is absorbed here.
 __all__ = [
     "FormatError",
     "NoExecutionNet",
-    "check_report",
     "execution_net",
     "from_bpmn",
     "from_pnml",
@@ -28,10 +27,9 @@ from typing import Any
 
 from django.core.exceptions import ValidationError
 
-from hrc.engine import FORMAT, FormatError, check_document, read_pattern, write_pattern
+from hrc.engine import FORMAT, FormatError, read_pattern, write_pattern
 from hrc.engine.bpmn import bpmn_to_pattern, is_bpmn
 from hrc.engine.bpmn_export import pattern_to_bpmn
-from hrc.engine.budget import NO_TIME_LIMIT, Budget
 from hrc.engine.issues import Issue
 from hrc.engine.layout import is_laid_out, lay_out_pattern
 from hrc.engine.model import Pattern
@@ -50,18 +48,9 @@ def read_draft(document: object) -> Pattern:
     """Reads a draft; raises FormatError when it is not the shape of `hrc-pattern/1`.
 
     Only the shape counts: a draft may break the model's rules (duplicate ids,
-    an unsound net); `check_report` says what is wrong with it.
+    an unsound net); the check (hrc.patterns.checking) says what is wrong with it.
     """
     return read_pattern(document)
-
-
-def check_report(document: object, budget: Budget = NO_TIME_LIMIT) -> Report:
-    """The engine's full check of a document within `budget`, as JSON-ready data.
-
-    Never raises for bad input; see hrc.patterns.checking for the budgets of
-    requests and of publishing.
-    """
-    return check_document(document, budget).as_dict()
 
 
 def is_publishable(report: Report) -> bool:

@@ -22,10 +22,9 @@ from django.utils import timezone
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import cells_of
-from hrc.patterns.checking import publish_budget
+from hrc.patterns.checking import checked, publish_budget
 from hrc.patterns.documents import (
     Report,
-    check_report,
     is_publishable,
     read_draft,
     starter_document,
@@ -132,11 +131,11 @@ def publish_pattern(pattern: PatternModel, *, published_by: User) -> PatternVers
     # The check may take seconds, and on the embedded SQLite a transaction holds the whole
     # database's write lock: check first, and again under the lock only if the draft changed.
     draft = PatternModel.objects.values_list("draft", flat=True).get(pk=pattern.pk)
-    report = check_report(draft, publish_budget())
+    report = checked(draft, publish_budget())
     with transaction.atomic():
         locked = PatternModel.objects.select_for_update().get(pk=pattern.pk)
         if locked.draft != draft:
-            report = check_report(locked.draft, publish_budget())
+            report = checked(locked.draft, publish_budget())
         if not is_publishable(report):
             raise PublishRefused(report)
         last = locked.versions.aggregate(last=Max("number"))["last"] or 0

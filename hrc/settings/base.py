@@ -274,3 +274,5 @@ HRC_CHECK_MARKINGS = int(env_str("HRC_CHECK_MARKINGS") or 100_000)
 HRC_PUBLISH_CHECK_SECONDS = float(env_str("HRC_PUBLISH_CHECK_SECONDS") or 30.0)
 HRC_PUBLISH_CHECK_MARKINGS = int(env_str("HRC_PUBLISH_CHECK_MARKINGS") or 200_000)
 HRC_ENGINE_SLOTS = int(env_str("HRC_ENGINE_SLOTS") or 2)
+# Processes per web process that run the checks (hrc.patterns.checking), off its threads.
+HRC_ENGINE_WORKERS = int(env_str("HRC_ENGINE_WORKERS") or 2)

@@ -57,12 +57,11 @@ from hrc.patterns.api.serializers import (
     StartRightsSerializer,
     SwitchSerializer,
 )
-from hrc.patterns.checking import EngineBusy, engine_slot, interactive_budget
+from hrc.patterns.checking import EngineBusy, checked, engine_slot, interactive_budget
 from hrc.patterns.choices import DocumentFormat
 from hrc.patterns.documents import (
     FormatError,
     NoExecutionNet,
-    check_report,
     execution_net,
     from_bpmn,
     from_pnml,
@@ -186,7 +185,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         """
         pattern = self.get_object()
         with _engine_slot(pattern.organisation_id):
-            return Response(check_report(pattern.draft, interactive_budget()))
+            return Response(checked(pattern.draft, interactive_budget()))
 
     @extend_schema(
         request=None, responses={201: PatternVersionSerializer, 400: PublishRefusedSerializer}
@@ -292,7 +291,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         document = request.data
         read_draft(document)  # a shape error is the request's fault: 400
         with _engine_slot(_editing_organisation(request)):
-            return Response(check_report(document, interactive_budget()))
+            return Response(checked(document, interactive_budget()))
 
     @extend_schema(
         request=DOCUMENT_REQUEST,
