@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import urllib.error
 import urllib.request
 from concurrent.futures import ThreadPoolExecutor
@@ -12,6 +13,7 @@ from django.contrib.auth.models import User
 
 from hrc.organisations.models import Organisation
 from tests import factories
+from tests.engine.builders import parallel_lanes
 from tests.live.server import LiveServer
 from tests.postgres import sessions_opened
 
@@ -47,6 +49,8 @@ HOSTILE = [
     ("GET", "/api/cases/?limit=99999999999999999999&offset=-1", None),
     ("POST", "/api/work-items/%C2%B2/claim/", b"{}"),
     ("POST", "/api/cells/stop/", b'{"cell": ""}'),
+    # 20 KB whose state space took 9 s of the server's CPU per check.
+    ("POST", "/api/patterns/check-document/", json.dumps(parallel_lanes(10, 8)).encode()),
 ]
 HOSTILE_REQUESTS = 50
 
