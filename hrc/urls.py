@@ -2,11 +2,16 @@
 
 from django.contrib import admin
 from django.urls import include, path, re_path
-from drf_spectacular.views import SpectacularAPIView, SpectacularRedocView, SpectacularSwaggerView
+from drf_spectacular.views import (
+    SpectacularAPIView,
+    SpectacularRedocView,
+    SpectacularSwaggerSplitView,
+)
 from rest_framework.authtoken.views import obtain_auth_token
 
 from hrc import home, navigation
 from hrc.api.views import api_not_found
+from hrc.middleware import content_security_policy
 
 urlpatterns = [
     # Sends each role to its place: operators to their tablet (also after sign-in).
@@ -25,11 +30,22 @@ urlpatterns = [
     path("accounts/", include("django.contrib.auth.urls")),
     path("api/schema/", SpectacularAPIView.as_view(), name="api-schema"),
     # Swagger UI and ReDoc come from the project's static files (drf-spectacular-sidecar),
-    # so they work on a plant network with no way out.
-    path("api/docs/", SpectacularSwaggerView.as_view(url_name="api-schema"), name="api-docs"),
+    # so they work on a plant network with no way out. The split view serves Swagger UI's
+    # start-up script at ?script, not inline: the Content-Security-Policy refuses inline code.
+    path(
+        "api/docs/",
+        SpectacularSwaggerSplitView.as_view(
+            url_name="api-schema", template_name="api/swagger_ui.html"
+        ),
+        name="api-docs",
+    ),
+    # ReDoc's bundle writes its styles into <style> elements as it draws (styled-components),
+    # so this page admits inline styles; its scripts stay the site's own files only.
     path(
         "api/redoc/",
-        SpectacularRedocView.as_view(url_name="api-schema", template_name="api/redoc.html"),
+        content_security_policy(style_src=["'self'", "'unsafe-inline'"])(
+            SpectacularRedocView.as_view(url_name="api-schema", template_name="api/redoc.html")
+        ),
         name="api-redoc",
     ),
     # Machines trade a username and password for a token once, then send `Authorization: Token …`.
