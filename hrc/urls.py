@@ -39,13 +39,14 @@ urlpatterns = [
         ),
         name="api-docs",
     ),
-    # ReDoc's bundle writes its styles into <style> elements as it draws (styled-components),
-    # so this page admits inline styles; its scripts stay the site's own files only.
+    # ReDoc's bundle writes its styles into <style> elements as it draws (styled-components)
+    # and builds its search index in a worker it makes from a blob: so this page admits
+    # inline styles and blob: workers; its scripts stay the site's own files only.
     path(
         "api/redoc/",
-        content_security_policy(style_src=["'self'", "'unsafe-inline'"])(
-            SpectacularRedocView.as_view(url_name="api-schema", template_name="api/redoc.html")
-        ),
+        content_security_policy(
+            style_src=["'self'", "'unsafe-inline'"], worker_src=["'self'", "blob:"]
+        )(SpectacularRedocView.as_view(url_name="api-schema", template_name="api/redoc.html")),
         name="api-redoc",
     ),
     # Machines trade a username and password for a token once, then send `Authorization: Token …`.
