@@ -16,7 +16,15 @@ import sys
 from collections.abc import Callable, Iterator
 
 import pytest
-from playwright.sync_api import Browser, BrowserContext, ConsoleMessage, Page, Response, expect
+from playwright.sync_api import (
+    Browser,
+    BrowserContext,
+    ConsoleMessage,
+    Dialog,
+    Page,
+    Response,
+    expect,
+)
 
 from hrc.cobots.gateway.launcher import ROOT
 from tests.browser.conftest import TABLET
@@ -199,7 +207,12 @@ def test_the_admins_pages_work_under_the_policy(
     page.locator("table a").first.click()
     # The confirmation is asked by the site's script (data-confirm), not an onsubmit.
     questions: list[str] = []
-    page.once("dialog", lambda dialog: (questions.append(dialog.message), dialog.dismiss()))
+
+    def decline(dialog: Dialog) -> None:
+        questions.append(dialog.message)
+        dialog.dismiss()
+
+    page.once("dialog", decline)
     page.get_by_role("button", name="Delete the team").click()
     expect(page.get_by_role("button", name="Delete the team")).to_be_visible()
     assert questions[0].startswith("Delete the team "), questions
