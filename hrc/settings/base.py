@@ -46,6 +46,7 @@ INSTALLED_APPS = [
 
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
+    "hrc.middleware.ContentSecurityPolicyMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     "django.middleware.common.CommonMiddleware",
     "django.middleware.csrf.CsrfViewMiddleware",
@@ -56,6 +57,24 @@ MIDDLEWARE = [
     # Last, as axes asks: it turns a lockout into its 429 page.
     "axes.middleware.AxesMiddleware",
 ]
+
+# Every page's scripts, styles and images come from this server's static files, its
+# sockets and fetches go back to it, and no other site may frame it (docker/Caddyfile
+# sends the same to what Django does not serve). Scripts get their data from
+# json_script or data attributes, never inline code; styles are static files too.
+HRC_CONTENT_SECURITY_POLICY: dict[str, list[str]] = {
+    "default-src": ["'self'"],
+    "script-src": ["'self'"],
+    "style-src": ["'self'"],
+    # data: for the small icons that stylesheets embed (Swagger UI's, the admin's).
+    "img-src": ["'self'", "data:"],
+    # 'self' covers the tablets' and supervisors' WebSockets to this host (ws: and wss:).
+    "connect-src": ["'self'"],
+    "object-src": ["'none'"],
+    "base-uri": ["'self'"],
+    "form-action": ["'self'"],
+    "frame-ancestors": ["'none'"],
+}
 
 ROOT_URLCONF = "hrc.urls"
 WSGI_APPLICATION = "hrc.wsgi.application"

@@ -58,7 +58,12 @@ function legend(): HTMLElement {
   box.innerHTML =
     "<strong>Constraints</strong>" +
     Object.entries(CONSTRAINT_STYLE)
-      .map(([type, style]) => `<div class="hrc-legend-row" data-type="${type}">${ICONS[type]}<span><b style="color:${style.colour}">${type}</b> ${style.meaning}</span></div>`)
+      .map(([type, style]) => `<div class="hrc-legend-row" data-type="${type}">${ICONS[type]}<span><b>${type}</b> ${style.meaning}</span></div>`)
       .join("");
+  // Each name in its constraint's colour through the style object: the page's
+  // Content-Security-Policy refuses style attributes written in markup.
+  for (const name of box.querySelectorAll<HTMLElement>(".hrc-legend-row b")) {
+    name.style.color = CONSTRAINT_STYLE[name.textContent ?? ""]?.colour ?? "";
+  }
   return box;
 }
