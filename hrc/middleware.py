@@ -62,8 +62,8 @@ def policy_header(directives: Mapping[str, Sequence[str]]) -> str:
 class ContentSecurityPolicyMiddleware:
     """Sends settings.HRC_CONTENT_SECURITY_POLICY with every response that has no policy of its own.
 
-    Django 5.2 has no CSP support of its own, and django-csp is not installed (the plant's
-    build has no way to fetch it); a fixed policy needs no nonces and so no more than this.
+    Django 5.2 has no CSP support of its own (6.0 has). A fixed policy needs no nonces, so
+    these lines do what the django-csp package would, with one dependency fewer.
     A view that needs another policy sets the header itself (`content_security_policy`).
     """
 
