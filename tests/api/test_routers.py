@@ -1,11 +1,9 @@
 """Ids in API addresses are ASCII digits (hrc.api.routers); anything else is the API's JSON 404."""
 
 import pytest
-from django.urls import resolve
 from rest_framework.test import APIClient
 
 from hrc.cases.models import Case
-from hrc.live.api.views import StopCellView
 from hrc.patterns.models import PatternModel
 
 pytestmark = pytest.mark.django_db
@@ -46,7 +44,3 @@ def test_ascii_ids_still_reach_their_objects(
 ) -> None:
     assert engineer_client.get(f"/api/patterns/{pattern.pk}/").status_code == 200
     assert engineer_client.get(f"/api/cases/{choice_case.pk}/events/").status_code == 200
-
-
-def test_the_cells_stop_route_is_no_cell_id() -> None:
-    assert resolve("/api/cells/stop/").func.view_class is StopCellView  # type: ignore[attr-defined]

@@ -190,6 +190,18 @@ def test_a_bad_cell_name_and_a_cell_with_cobots_are_refused(
     assert Cell.objects.filter(pk=cell.pk).exists()
 
 
+@pytest.mark.parametrize("body", ["null", "1", "true"])
+def test_a_cell_change_whose_body_is_no_object_is_a_400(
+    admin_client: APIClient, organisation: Organisation, body: str
+) -> None:
+    cell = Cell.objects.create(organisation=organisation, name="weld", description="By the door")
+    response = admin_client.patch(f"/api/cells/{cell.pk}/", body, content_type="application/json")
+    assert response.status_code == 400
+    assert response.json()["detail"].startswith("Invalid input: ")
+    cell.refresh_from_db()
+    assert cell.description == "By the door"
+
+
 def test_stop_and_resume_still_reach_the_tablets_views(operator_client: APIClient) -> None:
     assert resolve("/api/cells/stop/").func.view_class is StopCellView  # type: ignore[attr-defined]
     response = operator_client.post("/api/cells/stop/", {"cell": "nocobots"}, format="json")
