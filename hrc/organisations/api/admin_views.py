@@ -80,7 +80,7 @@ class _AdminsWrite:
         if not admin_organisations_of(request.user).exists():
             raise PermissionDenied(ADMINS_ONLY)
         wanted = request.data.get("organisation") if hasattr(request.data, "get") else None
-        if isinstance(wanted, str) and wanted.isdigit():
+        if isinstance(wanted, str) and wanted.isascii() and wanted.isdigit():
             wanted = int(wanted)
         if isinstance(wanted, int) and organisations_of(request.user).filter(pk=wanted).exists():
             _check_admin(request, wanted)
