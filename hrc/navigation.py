@@ -130,7 +130,7 @@ def switch_organisation(request: HttpRequest) -> HttpResponse:
     not a member of is a 404, as if it did not exist. Nothing is stored then.
     """
     raw = request.POST.get("organisation", "")
-    if not raw.isdigit():
+    if not (raw.isascii() and raw.isdigit()):  # isdigit() alone takes "²", which int() refuses
         return _refused(request, 400, "organisation: choose one of your organisations.")
     if not memberships_of(request.user).filter(organisation_id=int(raw)).exists():
         return _refused(request, 404, "organisation: you are not a member of that organisation.")

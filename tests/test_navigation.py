@@ -295,6 +295,19 @@ def test_the_switcher_refuses_an_id_that_is_not_a_number(engineer: User) -> None
     assert SESSION_KEY not in client.session
 
 
+@pytest.mark.parametrize("written", ["²", "٢"])  # isdigit() says yes to both; int() reads "٢"
+def test_the_switcher_refuses_an_id_in_other_digits_than_ascii(
+    commuter: User, written: str
+) -> None:
+    client = _client(commuter)
+
+    response = client.post("/organisation/switch/", {"organisation": written})
+
+    assert response.status_code == 400
+    assert "organisation: choose one of your organisations." in response.content.decode()
+    assert SESSION_KEY not in client.session
+
+
 def test_the_switcher_takes_only_a_post_from_a_signed_in_person(
     commuter: User, other_organisation: Organisation
 ) -> None:

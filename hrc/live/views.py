@@ -89,7 +89,7 @@ def start_cycle(request: HttpRequest, cell: str, version: str) -> HttpResponse:
 
 def _access(request: HttpRequest) -> Access:
     raw = request.GET.get("organisation", "")
-    if raw and not raw.isdigit():
+    if raw and not (raw.isascii() and raw.isdigit()):  # isdigit() alone takes "²"
         raise PermissionDenied("organisation must be an id.")
     if not raw:
         # The organisation the person works in (the header's switcher), else their first.

@@ -332,9 +332,11 @@ def cell(request: HttpRequest, admin: Membership, pk: int) -> HttpResponse:
 def join(request: HttpRequest, uidb64: str, token: str) -> HttpResponse:
     """Where an invited person chooses their password, once, before the link expires."""
     try:
-        user = User.objects.filter(pk=int(force_str(urlsafe_base64_decode(uidb64)))).first()
+        uid = force_str(urlsafe_base64_decode(uidb64))
     except (ValueError, TypeError):
-        user = None
+        uid = ""
+    # ASCII digits only: int() would also read "٣" as 3, a link Django never wrote.
+    user = User.objects.filter(pk=int(uid)).first() if uid.isascii() and uid.isdigit() else None
     if user is None or not services.invitation_valid(user, token):
         context = {"message": "This invitation link has been used or has expired: ask your admin for a new one."}  # fmt: skip
         return render(request, "organisations/join.html", context, status=404)

@@ -121,7 +121,7 @@ def _target_organisation(request: HttpRequest) -> Organisation | None:
     """The organisation a new pattern goes to; None when the user may write in none of those asked."""
     writable = writable_organisations(request.user)
     requested = request.GET.get("organisation", "")
-    if requested.isdigit():
+    if requested.isascii() and requested.isdigit():  # isdigit() alone takes "²"
         return writable.filter(pk=int(requested)).first()
     return writable.order_by("name", "pk").first()
 

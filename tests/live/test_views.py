@@ -125,3 +125,11 @@ def test_a_retired_version_or_an_outsider_starts_nothing(
     assert _client(operator).post(f"/tablet/cell-a/start/{version.pk}/", {}).status_code == 404
     assert "Start a cycle" not in _client(operator).get("/tablet/cell-a/").content.decode()
     assert not Case.objects.exists()
+
+
+@pytest.mark.parametrize("written", ["%C2%B2", "%D9%A2"])  # "²" and "٢": isdigit() says yes
+def test_a_tablet_asked_for_an_organisation_in_other_digits_than_ascii_is_refused(
+    operator: User, written: str
+) -> None:
+    response = _client(operator).get(f"/tablet/?organisation={written}")
+    assert response.status_code == 403

@@ -8,6 +8,7 @@ from django.urls import resolve
 from rest_framework.test import APIClient
 
 from hrc.live.api.views import StopCellView
+from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import AdminAction, Role
 from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation, Team
 from tests.factories import make_cobot, make_member
@@ -188,6 +189,33 @@ def test_a_bad_cell_name_and_a_cell_with_cobots_are_refused(
     assert kept.status_code == 400
     assert "welder" in str(kept.data)
     assert Cell.objects.filter(pk=cell.pk).exists()
+
+
+@pytest.mark.parametrize("body", ["null", "1", "true"])
+def test_a_cell_change_whose_body_is_no_object_is_a_400(
+    admin_client: APIClient, organisation: Organisation, body: str
+) -> None:
+    cell = Cell.objects.create(organisation=organisation, name="weld", description="By the door")
+    response = admin_client.patch(f"/api/cells/{cell.pk}/", body, content_type="application/json")
+    assert response.status_code == 400
+    assert response.json()["detail"].startswith("Invalid input: ")
+    cell.refresh_from_db()
+    assert cell.description == "By the door"
+
+
+def test_a_cell_for_an_organisation_in_other_digits_than_ascii_is_refused(
+    organisation: Organisation, other_organisation: Organisation
+) -> None:
+    """ "²" passes str.isdigit() and fails int() (a 500); "٢" is read as 2 by int()."""
+    user = make_member(organisation, Role.ADMIN, "dana-double")
+    organisation_services.add_member(other_organisation, user, Role.ENGINEER)
+    arabic = str(other_organisation.pk).translate(str.maketrans("0123456789", "٠١٢٣٤٥٦٧٨٩"))
+    client = _client(user)
+    for written in ("²", arabic):
+        response = client.post("/api/cells/", {"organisation": written, "name": "weld"}, format="json")  # fmt: skip
+        assert response.status_code == 400
+        assert "organisation" in response.data["fields"]
+    assert not Cell.objects.filter(name="weld").exists()
 
 
 def test_stop_and_resume_still_reach_the_tablets_views(operator_client: APIClient) -> None:

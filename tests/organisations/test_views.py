@@ -7,6 +7,7 @@ import re
 import pytest
 from django.contrib.auth.models import User
 from django.test import Client
+from django.utils.http import urlsafe_base64_encode
 
 from hrc.organisations.choices import AdminAction, Role
 from hrc.organisations.models import AdminRecord, Cell, Membership, Organisation, Team
@@ -218,3 +219,16 @@ def test_a_forged_invitation_link_is_refused(page: Client, operator: User) -> No
     uid, _ = invitation_for(operator)
     assert Client().get(f"/organisation/join/{uid}/forged-token/").status_code == 404
     assert Client().get("/organisation/join/!!/forged-token/").status_code == 404
+
+
+def test_an_invitation_link_with_the_id_in_other_digits_than_ascii_is_refused(
+    operator: User,
+) -> None:
+    _, token = invitation_for(operator)
+    arabic = str(operator.pk).translate(str.maketrans("0123456789", "٠١٢٣٤٥٦٧٨٩"))
+    uid = urlsafe_base64_encode(arabic.encode())
+    assert Client().get(f"/organisation/join/{uid}/{token}/").status_code == 404
+    assert (
+        Client().get(f"/organisation/join/{invitation_for(operator)[0]}/{token}/").status_code
+        == 200
+    )

@@ -164,3 +164,11 @@ def test_only_writers_of_the_organisation_archive(
     )
     pattern.refresh_from_db()
     assert pattern.archived_at is None
+
+
+def test_a_new_pattern_for_an_organisation_in_other_digits_than_ascii_goes_to_the_default(
+    engineer: User, organisation: Organisation
+) -> None:
+    response = _browser(engineer).get("/patterns/new/?organisation=%C2%B2")  # "²"
+    assert response.status_code == 200
+    assert _config(response.content.decode())["pattern"]["organisation"] == organisation.pk

@@ -2,8 +2,8 @@
 /api/pattern-versions/{id}/actor-mapping/ (a version's setting that belongs to running it)."""
 
 from django.urls import path
-from rest_framework.routers import SimpleRouter
 
+from hrc.api.routers import IdRouter
 from hrc.cases.api.views import (
     ActorMappingView,
     CaseViewSet,
@@ -13,7 +13,7 @@ from hrc.cases.api.views import (
     WorkItemViewSet,
 )
 
-router = SimpleRouter()
+router = IdRouter()
 router.register("cases", CaseViewSet, basename="case")
 router.register("work-items", WorkItemViewSet, basename="work-item")
 router.register("incidents", IncidentViewSet, basename="incident")

@@ -320,7 +320,7 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
 def _item_id(pk: str | None) -> int:
     """The work item an action names. Its services read it under its case's lock, through the
     user's memberships (404 for an outsider): a read here first would cost every action a query."""
-    if pk is None or not pk.isdigit():
+    if pk is None or not ID_PATTERN.fullmatch(pk):
         raise NotFound(f"There is no work item {pk} in your organisations.")
     return int(pk)
 

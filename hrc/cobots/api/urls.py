@@ -1,10 +1,9 @@
 """/api/cobots/…"""
 
-from rest_framework.routers import SimpleRouter
-
+from hrc.api.routers import IdRouter
 from hrc.cobots.api.views import CobotViewSet
 
-router = SimpleRouter()
+router = IdRouter()
 router.register("cobots", CobotViewSet, basename="cobot")
 
 urlpatterns = router.urls

@@ -80,7 +80,7 @@ class _AdminsWrite:
         if not admin_organisations_of(request.user).exists():
             raise PermissionDenied(ADMINS_ONLY)
         wanted = request.data.get("organisation") if hasattr(request.data, "get") else None
-        if isinstance(wanted, str) and wanted.isdigit():
+        if isinstance(wanted, str) and wanted.isascii() and wanted.isdigit():
             wanted = int(wanted)
         if isinstance(wanted, int) and organisations_of(request.user).filter(pk=wanted).exists():
             _check_admin(request, wanted)
@@ -237,10 +237,10 @@ class CellViewSet(_AdminsWrite, viewsets.ModelViewSet[Cell]):
 
     def partial_update(self, request: Request, *args: Any, **kwargs: Any) -> Response:
         cell = self.get_object()
+        serializer = self.get_serializer(cell, data=request.data, partial=True)
+        serializer.is_valid(raise_exception=True)  # first: it refuses a body that is no object
         if set(request.data) - {"description"}:
             raise ValidationError({"name": "Only a cell's description changes: its name is its tablet's address."})  # fmt: skip
-        serializer = self.get_serializer(cell, data=request.data, partial=True)
-        serializer.is_valid(raise_exception=True)
         description = serializer.validated_data.get("description", cell.description)
         try:
             services.describe_cell(cell, by=_user(request), description=description)

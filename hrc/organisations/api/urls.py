@@ -1,7 +1,6 @@
 """/api/organisations/ (with me/), and the administration: members/, teams/, cells/, admin-records/."""
 
-from rest_framework.routers import SimpleRouter
-
+from hrc.api.routers import IdRouter
 from hrc.organisations.api.admin_views import (
     AdminRecordViewSet,
     CellViewSet,
@@ -10,7 +9,7 @@ from hrc.organisations.api.admin_views import (
 )
 from hrc.organisations.api.views import OrganisationViewSet
 
-router = SimpleRouter()
+router = IdRouter()
 router.register("organisations", OrganisationViewSet, basename="organisation")
 router.register("members", MemberViewSet, basename="member")
 router.register("teams", TeamViewSet, basename="team")

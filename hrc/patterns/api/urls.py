@@ -1,10 +1,9 @@
 """/api/patterns/… and /api/pattern-versions/…"""
 
-from rest_framework.routers import SimpleRouter
-
+from hrc.api.routers import IdRouter
 from hrc.patterns.api.views import PatternVersionViewSet, PatternViewSet
 
-router = SimpleRouter()
+router = IdRouter()
 router.register("patterns", PatternViewSet, basename="pattern")
 router.register("pattern-versions", PatternVersionViewSet, basename="pattern-version")
 
