@@ -31,7 +31,7 @@ def read_limited(stream: IO[bytes], parser_context: Mapping[str, Any] | None) ->
     request = (parser_context or {}).get("request")
     meta = getattr(request, "META", {})
     declared = meta.get("CONTENT_LENGTH") or meta.get("HTTP_CONTENT_LENGTH") or "0"
-    if declared.isdigit() and int(declared) > limit:
+    if declared.isascii() and declared.isdigit() and int(declared) > limit:
         raise RequestDataTooBig("The request body is larger than the limit.")
     body = stream.read(limit + 1)
     if len(body) > limit:

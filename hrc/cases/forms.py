@@ -80,8 +80,10 @@ class MappingForm(forms.Form):
             value = self.cleaned_data.get(actor_field_name(actor.id), "")
             kind, _, ids = value.partition(":")
             if kind == "users":
-                chosen[actor.id] = {"users": [int(i) for i in ids.split(",") if i.isdigit()]}
-            elif kind in ("team", "cobot") and ids.isdigit():
+                chosen[actor.id] = {
+                    "users": [int(i) for i in ids.split(",") if i.isascii() and i.isdigit()]
+                }
+            elif kind in ("team", "cobot") and ids.isascii() and ids.isdigit():
                 chosen[actor.id] = {kind: int(ids)}
         return chosen
 

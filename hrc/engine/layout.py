@@ -136,9 +136,11 @@ def _is_number(value: object) -> bool:
 
 def natural_key(text: str) -> tuple[tuple[tuple[int, int, str], ...], str]:
     """Sorts "p2" before "p10": runs of digits compare as numbers, the rest as text."""
-    parts = re.split(r"(\d+)", text)
+    parts = re.split(r"([0-9]+)", text)
     numbered = tuple(
-        (0, int(part), part) if part.isdigit() else (1, 0, part) for part in parts if part
+        (0, int(part), part) if part.isascii() and part.isdigit() else (1, 0, part)
+        for part in parts
+        if part
     )
     return numbered, text
 

@@ -230,7 +230,7 @@ def _parameters(query_string: bytes) -> tuple[int | None, str]:
     """(organisation id or None, cell) from the query string; ValueError naming what is wrong."""
     query = parse_qs(query_string.decode("latin-1"))
     raw = (query.get("organisation") or [""])[0]
-    if raw and not raw.isdigit():
+    if raw and not (raw.isascii() and raw.isdigit()):
         raise ValueError(f"organisation must be an id (a whole number), not {raw!r}.")
     cell = (query.get("cell") or [""])[0]
     try:

@@ -50,3 +50,8 @@ def test_values_that_would_crash_later_are_parse_errors(body: bytes) -> None:
 
 def test_utf16_json_is_read() -> None:
     assert _parse('{"a": "ü"}'.encode("utf-16")) == {"a": "ü"}
+
+
+def test_a_declared_length_in_other_digits_than_ascii_is_not_read_as_one() -> None:
+    # "²" passes str.isdigit() and fails int(): it was a 500.
+    assert _parse(b"{}", declared="²") == {}

@@ -375,3 +375,8 @@ def test_is_laid_out_tells_a_drawn_model_from_one_without_positions() -> None:
     del laid_out["actors"][-1]
     laid_out["processes"][0]["places"][0]["layout"] = {"x": "left"}
     assert not is_laid_out(read_pattern(laid_out))
+
+
+def test_ids_with_other_digits_than_ascii_sort_as_text() -> None:
+    # "²" passes str.isdigit() and fails int(); "٣" is a digit int() reads as 3.
+    assert sorted(["t٣", "²", "t2"], key=natural_key) == ["t2", "t٣", "²"]

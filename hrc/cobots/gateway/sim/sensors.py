@@ -121,7 +121,7 @@ class Recognition:
         if text == "":
             return
         if path == SCREWS_NEXT:
-            if not (text.isdigit() and int(text) <= MAX_SCREWS):
+            if not (text.isascii() and text.isdigit() and int(text) <= MAX_SCREWS):
                 raise CommandFailed(
                     f"{path} must be a count of screws 0–{MAX_SCREWS} or '' (random), "
                     f"not {text!r}.",

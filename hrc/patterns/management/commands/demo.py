@@ -227,7 +227,9 @@ def _interrupt(signum: int, frame: FrameType | None) -> None:
 
 def _cobot_ports(value: str) -> dict[str, int]:
     parts = [part.strip() for part in value.split(",")]
-    if len(parts) != len(DEMO_COBOTS) or not all(part.isdigit() for part in parts):
+    if len(parts) != len(DEMO_COBOTS) or not all(
+        part.isascii() and part.isdigit() for part in parts
+    ):
         raise CommandError(
             f"--cobot-ports needs {len(DEMO_COBOTS)} port numbers separated by a comma, got {value!r}."
         )
