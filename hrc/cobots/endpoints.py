@@ -9,6 +9,7 @@ model's checks share it.
 
 from __future__ import annotations
 
+import asyncio
 import ipaddress
 import re
 import socket
@@ -87,8 +88,11 @@ def canonical_host(host: str) -> str:
     return LOOPBACK if name == "localhost" or name.endswith(".localhost") else name
 
 
-def endpoint_key(endpoint: str) -> EndpointKey:
-    """The key two registrations of the same server share; raises EndpointError when unparsable."""
+def host_and_port(endpoint: str) -> tuple[str, int]:
+    """The endpoint's host as written (brackets off) and its port (OPC UA's default when none).
+
+    Raises EndpointError when it is no opc.tcp URL with a host.
+    """
     try:
         parts = urlsplit(endpoint)
         port = parts.port
@@ -98,7 +102,13 @@ def endpoint_key(endpoint: str) -> EndpointKey:
         raise EndpointError(f"{endpoint!r} does not start with {SCHEME}://.")
     if not parts.hostname:
         raise EndpointError(f"The endpoint {endpoint!r} names no host.")
-    return EndpointKey(SCHEME, canonical_host(parts.hostname), port or DEFAULT_PORT)
+    return parts.hostname, port or DEFAULT_PORT
+
+
+def endpoint_key(endpoint: str) -> EndpointKey:
+    """The key two registrations of the same server share; raises EndpointError when unparsable."""
+    host, port = host_and_port(endpoint)
+    return EndpointKey(SCHEME, canonical_host(host), port)
 
 
 def url_host(host: str) -> str:
@@ -160,6 +170,30 @@ def outside(addresses: Sequence[IPAddress], networks: Sequence[IPNetwork]) -> li
     if not networks:
         return []
     return [a for a in addresses if not any(a.version == n.version and a in n for n in networks)]
+
+
+async def check_networks(endpoint: str, networks: Sequence[IPNetwork]) -> None:
+    """Resolves the endpoint's host (without blocking the loop) and raises EndpointError unless
+    every address is in one of the networks; no networks: no restriction."""
+    if not networks:
+        return
+    host, port = host_and_port(endpoint)
+    address = parse_address(host)
+    if address is not None:
+        found = [address]
+    else:
+        try:
+            infos = await asyncio.get_running_loop().getaddrinfo(
+                host, port, type=socket.SOCK_STREAM
+            )
+        except (OSError, UnicodeError):
+            raise EndpointError(f"The host {host} cannot be resolved.") from None
+        found = addresses_of(info[4][0] for info in infos)
+    if not found or outside(found, networks):
+        raise EndpointError(
+            f"The host {host} is outside the networks cobot endpoints may be on "
+            "(HRC_COBOT_NETWORKS)."
+        )
 
 
 def _is_local(address: IPAddress) -> bool:

@@ -48,7 +48,9 @@ def test_cobot_step_reports_a_protective_stop_clearly(
 
 def test_cobot_step_reports_a_dead_gateway_without_hanging() -> None:
     endpoint = f"opc.tcp://127.0.0.1:{free_port()}"
-    with pytest.raises(CommandError, match=r"cannot reach the gateway.*a retry may help"):
+    with pytest.raises(
+        CommandError, match=r"Cannot reach cobot cobot1 at its endpoint.*a retry may help"
+    ):
         run(
             "cobot_step",
             "cobot1",
