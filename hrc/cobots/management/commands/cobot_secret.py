@@ -57,7 +57,7 @@ class Command(BaseCommand):
                 services.update_cobot(cobot, credentials_source=f"secret:{options['name']}")
         except ValidationError as error:
             raise CommandError(" ".join(error.messages)) from None
-        used_by = f"; {', '.join(options['cobot'])} sign in with it" if options["cobot"] else ""
+        used_by = f"; used by {', '.join(options['cobot'])}" if options["cobot"] else ""
         self.stdout.write(f"{organisation.name}: secret {options['name']} set{used_by}.")
 
 
