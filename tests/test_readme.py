@@ -229,7 +229,17 @@ def test_the_readme_commands_work_on_a_fresh_clone(clone: Clone) -> None:
     )
     wait_for_port(port, gateway)
     subprocess.run(
-        [sys.executable, "manage.py", "load_demo", f"--cobot-endpoint=opc.tcp://127.0.0.1:{port}"],
+        [sys.executable, "manage.py", "load_demo"],
+        cwd=ROOT, env=clone.environment, check=True, capture_output=True, timeout=120,
+    )  # fmt: skip
+    # Only cobot1 moves to the gateway's port: one endpoint belongs to one cobot.
+    move = (
+        "from hrc.cobots import services; from hrc.cobots.models import Cobot; "
+        "services.update_cobot(Cobot.objects.get(name='cobot1', organisation__slug='demo-plant'), "
+        f"endpoint='opc.tcp://127.0.0.1:{port}')"
+    )
+    subprocess.run(
+        [sys.executable, "manage.py", "shell", "-c", move],
         cwd=ROOT, env=clone.environment, check=True, capture_output=True, timeout=120,
     )  # fmt: skip
     powered = clone.run(".venv/bin/python manage.py cobot_call cobot1 PowerOn")
