@@ -67,7 +67,13 @@ RUN_HERE = {
     "--simulate --cases 3 --time-scale 0.05 --json",
     ".venv/bin/python manage.py live_cobots",
     "docker compose run --rm web python manage.py load_demo --cobot-endpoint "
-    "'opc.tcp://gateway-{cobot}:4840' --cobot-credentials 'env:{COBOT}_CREDENTIALS'",
+    "'opc.tcp://gateway-{cobot}:4840'",
+    *(
+        f"docker compose run --rm -e COBOT{n}_GATEWAY_PASSWORD web python manage.py cobot_secret "
+        f"cobot{n} --organisation demo-plant --user hrc --password-env COBOT{n}_GATEWAY_PASSWORD "
+        f"--cobot cobot{n}"
+        for n in (1, 2)
+    ),
 }
 
 
@@ -223,7 +229,17 @@ def test_the_readme_commands_work_on_a_fresh_clone(clone: Clone) -> None:
     )
     wait_for_port(port, gateway)
     subprocess.run(
-        [sys.executable, "manage.py", "load_demo", f"--cobot-endpoint=opc.tcp://127.0.0.1:{port}"],
+        [sys.executable, "manage.py", "load_demo"],
+        cwd=ROOT, env=clone.environment, check=True, capture_output=True, timeout=120,
+    )  # fmt: skip
+    # Only cobot1 moves to the gateway's port: one endpoint belongs to one cobot.
+    move = (
+        "from hrc.cobots import services; from hrc.cobots.models import Cobot; "
+        "services.update_cobot(Cobot.objects.get(name='cobot1', organisation__slug='demo-plant'), "
+        f"endpoint='opc.tcp://127.0.0.1:{port}')"
+    )
+    subprocess.run(
+        [sys.executable, "manage.py", "shell", "-c", move],
         cwd=ROOT, env=clone.environment, check=True, capture_output=True, timeout=120,
     )  # fmt: skip
     powered = clone.run(".venv/bin/python manage.py cobot_call cobot1 PowerOn")
@@ -249,16 +265,23 @@ def test_the_readme_commands_work_on_a_fresh_clone(clone: Clone) -> None:
 
 
 def test_the_docker_load_demo_arguments_register_the_gateways(clone: Clone) -> None:
-    command = next(c for c in RUN_HERE if c.startswith("docker compose run"))
-    here = command.replace("docker compose run --rm web python", ".venv/bin/python")
+    # In the README's order: the demo, then each gateway's credentials secret.
+    commands = [c for c in all_commands() if c.startswith("docker compose run") and c in RUN_HERE]
     subprocess.run(
         ["bash", "-c", ".venv/bin/python manage.py migrate"], cwd=ROOT, env=clone.environment,
         check=True, capture_output=True, timeout=120,
     )  # fmt: skip
+    environment = {
+        **clone.environment,
+        "COBOT1_GATEWAY_PASSWORD": "p1",
+        "COBOT2_GATEWAY_PASSWORD": "p2",
+    }
 
-    result = subprocess.run(
-        ["bash", "-c", here], cwd=ROOT, env=clone.environment,
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-
-    assert result.returncode == 0, result.stderr
+    for command in commands:
+        here = re.sub(r"docker compose run --rm (-e \S+ )?web python", ".venv/bin/python", command)
+        result = subprocess.run(
+            ["bash", "-c", here], cwd=ROOT, env=environment,
+            capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+    assert len(commands) == 3

@@ -13,14 +13,13 @@ class DriverKind(models.TextChoices):
 
 
 class CredentialsKind(models.TextChoices):
-    """Where a driver finds the cobot's credentials; the secret itself is never in the database."""
+    """Where a driver finds the cobot's credentials: never the worker's environment or files,
+    which every organisation's cobots would share."""
 
     # The endpoint needs no credentials (the simulator, a lab network).
     NONE = "none", "No credentials"
-    # Read at connect time from the named environment variable of the worker process.
-    ENV = "env", "Environment variable"
-    # Read at connect time from a file, e.g. a Docker or Kubernetes secret under /run/secrets/.
-    FILE = "file", "File"
+    # A named secret of the cobot's own organisation (CredentialsSecret), decrypted at connect time.
+    SECRET = "secret", "A named secret of the organisation"
 
 
 class ControlCommand(models.TextChoices):

@@ -48,3 +48,26 @@ class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs make
                 self.add_error(field if field in self.fields else None, messages)
         else:
             self.add_error(None, error.messages)
+
+
+class CredentialsSecretForm(forms.Form):
+    """Sets a credentials secret; the password field never shows a value back."""
+
+    name = forms.CharField(
+        max_length=64,
+        help_text="Cobots name it as their credentials source 'secret:NAME'. An existing name is "
+        "replaced.",
+    )
+    username = forms.CharField(
+        max_length=64, label="User name", help_text="The gateway user the driver signs in as."
+    )
+    password = forms.CharField(
+        max_length=1024,
+        strip=False,
+        widget=forms.PasswordInput(render_value=False),
+        help_text="Stored encrypted, never shown again.",
+    )
+
+    def add_service_errors(self, error: ValidationError) -> None:
+        for field, messages in error.message_dict.items():
+            self.add_error(field if field in self.fields else None, messages)

@@ -1,14 +1,23 @@
 """A cobot as the organisation knows it: a name, a driver and an endpoint.
 
-Credentials are referenced, not stored: `credentials_source` says where the
-worker reads them at connect time, so a database dump leaks no secrets.
+A gateway endpoint belongs to one cobot of one organisation (`endpoint_key`,
+unique), and a cobot's credentials are a named secret of its own
+organisation (CredentialsSecret, encrypted at rest), so no organisation can
+reach another's robot by its address or its credentials.
 """
 
 from django.conf import settings
+from django.core.exceptions import ValidationError
 from django.db import models
 
-from hrc.cobots.choices import CommandOutcome, ControlCommand, DriverKind
-from hrc.cobots.validators import validate_credentials_source, validate_endpoint
+from hrc.cobots import endpoints
+from hrc.cobots.choices import CommandOutcome, ControlCommand, CredentialsKind, DriverKind
+from hrc.cobots.validators import (
+    split_credentials_source,
+    validate_credentials_source,
+    validate_endpoint,
+    validate_secret_name,
+)
 from hrc.organisations.models import Organisation
 from hrc.organisations.validators import validate_cell
 
@@ -40,8 +49,19 @@ class Cobot(models.Model):
         default="none",
         validators=[validate_credentials_source],
         help_text=(
-            "Where the driver reads the credentials: 'none', 'env:VARIABLE_NAME' (an environment "
-            "variable of the worker) or 'file:/run/secrets/name'. Never type the secret itself here."
+            "The credentials the driver signs in with: 'none', or 'secret:NAME' for a credentials "
+            "secret of the organisation (Cobots → Credentials). Never type the secret itself here."
+        ),
+    )
+    # NULL, not "": rows that shared an endpoint before the rule keep NULL, which the
+    # unique constraint lets repeat, until someone gives them an endpoint of their own.
+    endpoint_key = models.CharField(  # noqa: DJ001
+        max_length=600,
+        null=True,
+        editable=False,
+        help_text=(
+            "The endpoint as the network sees it (hrc.cobots.endpoints.endpoint_key); unique, so one "
+            "gateway is one cobot's. Empty only for a cobot that shared its endpoint before the rule."
         ),
     )
     cell = models.CharField(
@@ -75,6 +95,143 @@ class Cobot(models.Model):
                 fields=["organisation", "name"],
                 name="cobot_name_unique_in_organisation",
                 violation_error_message="The organisation already has a cobot of this name.",
+            ),
+            # Two registrations racing past clean() cannot both commit.
+            models.UniqueConstraint(
+                fields=["endpoint_key"],
+                name="cobot_endpoint_registered_once",
+                violation_error_message="Another cobot is registered at this gateway endpoint.",
+            ),
+        ]
+
+    def __str__(self) -> str:
+        return self.name
+
+    def save(self, *args: object, **kwargs: object) -> None:
+        # Derived here, not in a service only, so that no write path can skip the constraint.
+        self.endpoint_key = key_of(self.endpoint)
+        update_fields = kwargs.get("update_fields")
+        if (
+            isinstance(update_fields, list | tuple | set | frozenset)
+            and "endpoint" in update_fields
+        ):
+            kwargs["update_fields"] = {*update_fields, "endpoint_key"}
+        super().save(*args, **kwargs)  # type: ignore[arg-type]
+
+    def clean(self) -> None:
+        """What needs the database or the network: the endpoint is free and within
+        HRC_COBOT_NETWORKS, the credentials secret is the organisation's. The admin's form, the
+        pages and the API all reach it through full_clean."""
+        errors: dict[str, str] = {}
+        key = key_of(self.endpoint)
+        if key is not None:
+            problem = self._endpoint_taken(key) or endpoint_outside_networks(self.endpoint)
+            if problem:
+                errors["endpoint"] = problem
+        problem = self._unknown_secret()
+        if problem:
+            errors["credentials_source"] = problem
+        if errors:
+            raise ValidationError(errors)
+
+    def _endpoint_taken(self, key: str) -> str | None:
+        holder = (
+            Cobot.objects.filter(endpoint_key=key)
+            .exclude(pk=self.pk)
+            .values_list("name", "organisation_id")
+            .first()
+        )
+        if holder is None:
+            return None
+        name, organisation_id = holder
+        # Another organisation's cobot is not named: its names are behind the wall.
+        whose = (
+            f"cobot {name}"
+            if organisation_id == self.organisation_id
+            else "a cobot of another organisation"
+        )
+        return (
+            f"The gateway at {self.endpoint} is already registered to {whose}: a gateway "
+            "endpoint (host and port) belongs to one cobot of one organisation."
+        )
+
+    def _unknown_secret(self) -> str | None:
+        parts = split_credentials_source(self.credentials_source)
+        if parts is None or parts[0] != CredentialsKind.SECRET:
+            return None  # 'none', or refused by the field's validator
+        exists = CredentialsSecret.objects.filter(
+            organisation_id=self.organisation_id, name=parts[1]
+        ).exists()
+        if exists:
+            return None
+        return (
+            f"The organisation has no credentials secret named {parts[1]}; an admin of the "
+            "organisation creates it under Cobots → Credentials."
+        )
+
+
+def key_of(endpoint: str) -> str | None:
+    """The endpoint's unique key; None for an endpoint too malformed to have one."""
+    try:
+        return str(endpoints.endpoint_key(endpoint))
+    except endpoints.EndpointError:
+        return None
+
+
+def endpoint_outside_networks(endpoint: str) -> str | None:
+    """Why the endpoint is refused under HRC_COBOT_NETWORKS, or None (also when it is unset)."""
+    networks = settings.HRC_COBOT_NETWORKS
+    if not networks:
+        return None
+    allowed = ", ".join(str(n) for n in networks)
+    try:
+        host, port = endpoints.host_and_port(endpoint)
+        addresses = endpoints.resolve(host, port)
+    except endpoints.EndpointError as error:
+        return f"{error} Cobot endpoints must be on the networks {allowed} (HRC_COBOT_NETWORKS)."
+    if endpoints.outside(addresses, networks) or not addresses:
+        return (
+            f"The host {host} is outside the networks cobot endpoints may be on: {allowed} "
+            "(HRC_COBOT_NETWORKS)."
+        )
+    return None
+
+
+class CredentialsSecret(models.Model):
+    """A user name and password an organisation's cobots sign in to their gateways with.
+
+    Set by an admin of the organisation, kept encrypted (hrc.cobots.credentials),
+    never shown back; a cobot names it as `secret:NAME`.
+    """
+
+    organisation = models.ForeignKey(
+        Organisation, on_delete=models.CASCADE, related_name="credentials_secrets"
+    )
+    name = models.CharField(
+        max_length=64,
+        validators=[validate_secret_name],
+        help_text="How cobots name it: a cobot's credentials source 'secret:NAME'.",
+    )
+    sealed = models.TextField(
+        editable=False, help_text="The user name and password, Fernet-encrypted."
+    )
+    updated_by = models.ForeignKey(
+        settings.AUTH_USER_MODEL,
+        on_delete=models.SET_NULL,
+        null=True,
+        blank=True,
+        related_name="+",
+        help_text="Who set it last (empty when set from the command line).",
+    )
+    updated_at = models.DateTimeField(auto_now=True)
+
+    class Meta:
+        ordering = ["organisation__name", "name"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["organisation", "name"],
+                name="credentials_secret_name_unique_in_organisation",
+                violation_error_message="The organisation already has a secret of this name.",
             )
         ]
 

@@ -53,9 +53,6 @@ from cryptography import x509
 from cryptography.hazmat.primitives.serialization import Encoding
 from cryptography.x509.oid import ExtendedKeyUsageOID
 
-from hrc.cobots.choices import CredentialsKind
-from hrc.cobots.validators import split_credentials_source
-
 if TYPE_CHECKING:
     from asyncua.server.internal_server import InternalServer
 
@@ -551,57 +548,7 @@ def _check_uri(certificate: bytes, uri: str, path: Path) -> None:
         )
 
 
-# --- Credentials and the --insecure rule -----------------------------------
-
-
-def parse_credentials(secret: str) -> tuple[str, str]:
-    """Splits a `username:password` secret at its first ':'; one trailing newline is dropped.
-
-    Raises PkiError (whose message never quotes the secret) when either part is empty.
-    """
-    if secret.endswith("\n"):
-        secret = secret[:-1].removesuffix("\r")
-    username, colon, password = secret.partition(":")
-    if not colon or not username or not password:
-        raise PkiError("The credentials are not in the form 'username:password'.")
-    return username, password
-
-
-def read_credentials(source: str) -> tuple[str, str] | None:
-    """Reads the (username, password) a cobot's credentials source points to; None for 'none'.
-
-    Sources are those `hrc.cobots.validators.validate_credentials_source`
-    accepts. Errors name the variable or file, never the secret.
-    """
-    parts = split_credentials_source(source)
-    kind, reference = parts if parts is not None else ("", "")
-    if kind == CredentialsKind.NONE:
-        return None
-    if kind == CredentialsKind.ENV:
-        secret = os.environ.get(reference)
-        if secret is None:
-            raise PkiError(f"The environment variable {reference} is not set.")
-        return _parse_from(secret, f"the environment variable {reference}")
-    if kind == CredentialsKind.FILE:
-        try:
-            secret = Path(reference).read_text()
-        except (OSError, UnicodeDecodeError) as exc:
-            reason = exc.strerror if isinstance(exc, OSError) else "it is not UTF-8 text"
-            raise PkiError(f"Cannot read the credentials file {reference}: {reason}.") from None
-        return _parse_from(secret, f"the file {reference}")
-    # Not quoted: a secret typed where its source belongs must not reach the logs.
-    raise PkiError(
-        "The credentials source is not 'none', 'env:VARIABLE_NAME' or 'file:/absolute/path'."
-    )
-
-
-def _parse_from(secret: str, where: str) -> tuple[str, str]:
-    try:
-        return parse_credentials(secret)
-    except PkiError:
-        raise PkiError(
-            f"The credentials in {where} are not in the form 'username:password'."
-        ) from None
+# --- The --insecure rule -----------------------------------
 
 
 def is_loopback(host: str) -> bool:

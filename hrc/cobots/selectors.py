@@ -4,7 +4,7 @@ from typing import Any
 
 from django.db.models import QuerySet
 
-from hrc.cobots.models import Cobot, CobotCommand
+from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
 from hrc.organisations.selectors import AnyUser, organisations_of
 
 
@@ -21,6 +21,15 @@ def cobots_in_cell(organisation_id: int, cell: str) -> list[str]:
         Cobot.objects.filter(organisation_id=organisation_id, cell=cell)
         .order_by("name")
         .values_list("name", flat=True)
+    )
+
+
+def credentials_secrets_of(organisation_id: int) -> QuerySet[CredentialsSecret]:
+    """The organisation's credentials secrets by name, with who set them (never their values)."""
+    return (
+        CredentialsSecret.objects.filter(organisation_id=organisation_id)
+        .select_related("updated_by")
+        .order_by("name")
     )
 
 

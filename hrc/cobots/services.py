@@ -1,11 +1,16 @@
-"""Every write to cobots. Callers check the user's role; these check the data (full_clean)."""
+"""Every write to cobots and their credentials secrets. Callers check the user's role (a
+writer for cobots, an admin for secrets); these check the data (full_clean)."""
 
+import re
 from typing import Any
 
+from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 from django.db import IntegrityError, transaction
 
-from hrc.cobots.models import Cobot
+from hrc.cobots.credentials import seal
+from hrc.cobots.models import Cobot, CredentialsSecret
+from hrc.cobots.validators import validate_secret_name
 from hrc.organisations.models import Organisation
 from hrc.organisations.services import ensure_cell
 
@@ -26,10 +31,7 @@ def create_cobot(organisation: Organisation, **fields: Any) -> Cobot:
             _register_cell(cobot)
             cobot.save()
     except IntegrityError:
-        # Another request took the name between full_clean and save.
-        raise ValidationError(
-            {"name": f"{organisation} already has a cobot named {cobot.name}."}
-        ) from None
+        _raced(cobot)
     return cobot
 
 
@@ -39,10 +41,22 @@ def update_cobot(cobot: Cobot, **changes: Any) -> Cobot:
     for field, value in changes.items():
         setattr(cobot, field, value)
     cobot.full_clean()
-    with transaction.atomic():
-        _register_cell(cobot)
-        cobot.save(update_fields=[*changes, "updated_at"])
+    try:
+        with transaction.atomic():
+            _register_cell(cobot)
+            cobot.save(update_fields=[*changes, "updated_at"])
+    except IntegrityError:
+        _raced(cobot)
     return cobot
+
+
+def _raced(cobot: Cobot) -> None:
+    """Another request took the name or the endpoint between full_clean and save (the unique
+    constraints held): the check, run again now that theirs is committed, says which."""
+    cobot.full_clean()
+    raise ValidationError(
+        f"Another cobot was registered with the name {cobot.name} or at {cobot.endpoint} just now."
+    )
 
 
 def delete_cobot(cobot: Cobot) -> None:
@@ -61,3 +75,53 @@ def _reject_unknown(fields: dict[str, Any]) -> None:
     unknown = set(fields) - set(EDITABLE_FIELDS)
     if unknown:
         raise TypeError(f"Not editable on a cobot: {', '.join(sorted(unknown))}")
+
+
+# Credentials secrets -----------------------------------------------------------------
+
+# The gateways' user names (hrc.cobots.pki): no blank and no ':'.
+_USERNAME = re.compile(r"[^\s:]{1,64}")
+MAX_PASSWORD = 1024
+
+
+def set_credentials_secret(
+    organisation: Organisation, name: str, *, username: str, password: str, by: User | None
+) -> CredentialsSecret:
+    """Creates the organisation's secret `name`, or replaces its user name and password.
+
+    The caller checks that `by` is an admin of the organisation (None: the command line).
+    Raises ValidationError naming the field that is wrong.
+    """
+    errors: dict[str, str] = {}
+    try:
+        validate_secret_name(name)
+    except ValidationError as error:
+        errors["name"] = error.messages[0]
+    if not _USERNAME.fullmatch(username):
+        errors["username"] = "The user name is 1 to 64 characters, with no blank and no ':'."
+    if not password or len(password) > MAX_PASSWORD:
+        errors["password"] = f"The password is 1 to {MAX_PASSWORD} characters."
+    if errors:
+        raise ValidationError(errors)
+    with transaction.atomic():
+        secret, _ = CredentialsSecret.objects.select_for_update().update_or_create(
+            organisation=organisation,
+            name=name,
+            defaults={"sealed": seal(username, password), "updated_by": by},
+        )
+    return secret
+
+
+def delete_credentials_secret(secret: CredentialsSecret) -> None:
+    """Forgets the secret; refused (ValidationError) while a cobot signs in with it."""
+    users = list(
+        Cobot.objects.filter(
+            organisation_id=secret.organisation_id, credentials_source=f"secret:{secret.name}"
+        ).values_list("name", flat=True)
+    )
+    if users:
+        raise ValidationError(
+            f"The cobots {', '.join(users)} sign in with {secret.name}; give them another "
+            "credentials source first."
+        )
+    secret.delete()

@@ -1,4 +1,4 @@
-"""The cobot pages: /cobots/, /cobots/<id>/, new/ and <id>/edit/ (the API's routes are api/urls.py)."""
+"""The cobot pages: /cobots/, /cobots/<id>/, new/, <id>/edit/ and credentials/ (the API's routes are api/urls.py)."""
 
 from django.urls import path
 
@@ -9,6 +9,7 @@ app_name = "cobots"
 urlpatterns = [
     path("cobots/", views.cobot_list, name="cobot-list"),
     path("cobots/new/", views.cobot_new, name="cobot-new"),
+    path("cobots/credentials/", views.credentials_secrets, name="credentials"),
     path("cobots/<int:pk>/", views.cobot_detail, name="cobot-detail"),
     path("cobots/<int:pk>/edit/", views.cobot_edit, name="cobot-edit"),
 ]

@@ -1,4 +1,9 @@
-"""Checks for a cobot's endpoint and credentials reference, shared by the model, admin and API."""
+"""Checks for a cobot's endpoint and credentials reference, shared by the model, admin and API.
+
+These check one value; what needs the database or the network (an endpoint
+registered once, a secret of the cobot's organisation, HRC_COBOT_NETWORKS)
+is Cobot.clean's.
+"""
 
 import re
 from urllib.parse import urlsplit
@@ -6,9 +11,18 @@ from urllib.parse import urlsplit
 from django.core.exceptions import ValidationError
 
 from hrc.cobots.choices import CredentialsKind
+from hrc.cobots.endpoints import EndpointError, endpoint_key
 
 ENDPOINT_SCHEME = "opc.tcp"
-_ENV_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+SECRET_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
+# Sources that read the worker's own environment or files: every organisation's cobots
+# would share them, so one organisation could borrow another's credentials.
+WORKER_SOURCES = ("env:", "file:")
+WORKER_SOURCES_REFUSED = (
+    "Credentials are not read from the worker's environment or files ('env:' and 'file:' "
+    "sources): an admin of the organisation creates a named credentials secret (Cobots → "
+    "Credentials, or `manage.py cobot_secret`), and the cobot uses 'secret:NAME'."
+)
 
 
 def validate_endpoint(value: str) -> None:
@@ -30,28 +44,47 @@ def validate_endpoint(value: str) -> None:
         raise ValidationError(
             "Put no user name or password in the endpoint; use the credentials source instead."
         )
+    try:
+        endpoint_key(value)
+    except EndpointError as error:
+        raise ValidationError(str(error)) from None
 
 
 def split_credentials_source(value: str) -> tuple[CredentialsKind, str] | None:
-    """(kind, reference) of `none`, `env:VARIABLE` or `file:/absolute/path`; None for anything else.
+    """(kind, secret name) of `none` or `secret:NAME`; None for anything else.
 
     The one reading of a source, for the model's check and the driver's lookup alike.
     """
     kind, _, reference = value.partition(":")
     if kind == CredentialsKind.NONE and not reference:
         return CredentialsKind.NONE, ""
-    if kind == CredentialsKind.ENV and _ENV_NAME.fullmatch(reference):
-        return CredentialsKind.ENV, reference
-    if kind == CredentialsKind.FILE and reference.startswith("/"):
-        return CredentialsKind.FILE, reference
+    if kind == CredentialsKind.SECRET and SECRET_NAME.fullmatch(reference):
+        return CredentialsKind.SECRET, reference
     return None
 
 
-def validate_credentials_source(value: str) -> None:
-    """Accepts `none`, `env:VARIABLE` or `file:/absolute/path`: a reference, never a secret."""
+def credentials_source_problem(value: str) -> str | None:
+    """Why the source is refused, or None. Never quotes it: a secret typed here must not echo."""
     if split_credentials_source(value) is not None:
-        return
-    raise ValidationError(
-        "The credentials source must be 'none', 'env:VARIABLE_NAME' or 'file:/absolute/path'; "
-        "it says where the secret is, never the secret itself."
+        return None
+    if value.startswith(WORKER_SOURCES):
+        return WORKER_SOURCES_REFUSED
+    return (
+        "The credentials source must be 'none' or 'secret:NAME', NAME a credentials secret of "
+        "the organisation; it says where the secret is, never the secret itself."
     )
+
+
+def validate_credentials_source(value: str) -> None:
+    """Accepts `none` or `secret:NAME`: a reference, never a secret."""
+    problem = credentials_source_problem(value)
+    if problem is not None:
+        raise ValidationError(problem)
+
+
+def validate_secret_name(value: str) -> None:
+    if not SECRET_NAME.fullmatch(value):
+        raise ValidationError(
+            f"{value!r} is not a secret name: up to 64 letters, digits, '.', '_' or '-', "
+            "starting with a letter or digit."
+        )

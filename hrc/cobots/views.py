@@ -24,15 +24,21 @@ from django.views.decorators.http import require_http_methods
 
 from hrc.cobots import control, hooks, services, urua
 from hrc.cobots.choices import ControlCommand
-from hrc.cobots.forms import CobotForm
+from hrc.cobots.forms import CobotForm, CredentialsSecretForm
 from hrc.cobots.models import Cobot
-from hrc.cobots.selectors import cobots_visible_to, commands_of, live_state
+from hrc.cobots.selectors import (
+    cobots_visible_to,
+    commands_of,
+    credentials_secrets_of,
+    live_state,
+)
 from hrc.navigation import current_membership
-from hrc.organisations.choices import WRITER_ROLES, AdminAction
+from hrc.organisations.choices import WRITER_ROLES, AdminAction, Role
 from hrc.organisations.selectors import may_write_in, writable_organisations
 from hrc.organisations.services import record_admin_action
 
 ENGINEERS_ONLY = "Only engineers and admins of the organisation control its cobots."
+ADMINS_ONLY = "Only admins of the organisation set its cobots' credentials."
 COMMANDS_PER_PAGE = 20
 # Seconds the list waits for each cobot's state; an unreachable one says so instead.
 LIST_STATE_TIMEOUT = 1.5
@@ -147,6 +153,52 @@ def cobot_edit(request: HttpRequest, pk: int) -> HttpResponse:
     status = 400 if form.errors else 200
     context = {"form": form, "cobot": cobot, "tested": tested}
     return render(request, "cobots/cobot_form.html", context, status=status)
+
+
+@require_http_methods(["GET", "POST"])
+@login_required
+def credentials_secrets(request: HttpRequest) -> HttpResponse:
+    """The organisation's credentials secrets, by name only; an admin sets, replaces and
+    deletes them. Nobody, the admin included, sees a password again."""
+    membership = current_membership(request)
+    if membership is None or membership.role != Role.ADMIN:
+        return _refused(request, 403, ADMINS_ONLY)
+    organisation = membership.organisation
+    form = CredentialsSecretForm()
+    problem = ""
+    if request.method == "POST" and "delete" in request.POST:
+        secret = credentials_secrets_of(organisation.pk).filter(pk=request.POST["delete"]).first()
+        if secret is None:
+            raise Http404("No such secret.")
+        try:
+            services.delete_credentials_secret(secret)
+        except ValidationError as error:
+            problem = " ".join(error.messages)
+        else:
+            return HttpResponseRedirect(reverse("cobots:credentials"))
+    elif request.method == "POST":
+        form = CredentialsSecretForm(request.POST)
+        if form.is_valid():
+            try:
+                services.set_credentials_secret(
+                    organisation,
+                    form.cleaned_data["name"],
+                    username=form.cleaned_data["username"],
+                    password=form.cleaned_data["password"],
+                    by=request.user if isinstance(request.user, User) else None,
+                )
+            except ValidationError as error:
+                form.add_service_errors(error)
+            else:
+                return HttpResponseRedirect(reverse("cobots:credentials"))
+    context = {
+        "form": form,
+        "secrets": credentials_secrets_of(organisation.pk),
+        "problem": problem,
+        "organisation": organisation,
+    }
+    status = 400 if form.errors or problem else 200
+    return render(request, "cobots/credentials.html", context, status=status)
 
 
 def _record(cobot: Cobot, by: Any, action: AdminAction, values: dict[str, Any]) -> None:

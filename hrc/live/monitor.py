@@ -25,8 +25,11 @@ from django.conf import settings
 from django.db import connections
 
 from hrc.cobots import urua
+from hrc.cobots.credentials import CredentialsError, credentials_for
+from hrc.cobots.drivers.base import unreachable_message
+from hrc.cobots.endpoints import check_networks
 from hrc.cobots.models import Cobot
-from hrc.cobots.pki import PkiError, read_credentials, secure_client
+from hrc.cobots.pki import PkiError, secure_client
 from hrc.live import broadcast, cobot_states
 from hrc.live.events import CobotStateData
 
@@ -167,17 +170,23 @@ class Monitor:
                 delay = BACKOFF[0]
             except asyncio.CancelledError:
                 raise
+            except CredentialsError as error:  # the organisation's own set-up, said as it is
+                watched.update(reachable=False, error=str(error))
             except Exception as error:  # any failure of the session: report it, try again
-                watched.update(
-                    reachable=False, error=f"{watched.name}: {error or type(error).__name__}"
-                )
+                # One message whatever is at the endpoint (no port oracle); the detail is logged.
+                logger.warning(
+                    "Cannot watch cobot %s at %s: %s",
+                    watched.name, watched.endpoint, error or type(error).__name__,
+                )  # fmt: skip
+                watched.update(reachable=False, error=unreachable_message(watched.name))
             await asyncio.sleep(delay)
             delay = min(delay * 2, BACKOFF[1])
 
     async def _watch(self, watched: Watched) -> None:
+        await check_networks(watched.endpoint, settings.HRC_COBOT_NETWORKS)
         client = Client(watched.endpoint, timeout=4)
         client.name = client.description = f"hrc live monitor for {watched.name}"
-        credentials = read_credentials(watched.credentials_source)
+        credentials = await sync_to_async(_credentials)(watched)
         if credentials is not None:
             try:
                 await secure_client(client, settings.HRC_PKI_DIR, watched.name, *credentials)
@@ -213,7 +222,9 @@ class Monitor:
                 await subscription.subscribe_data_change([display], queuesize=1)
             watched.update(reachable=True, error="")
             await lost.wait()
-            watched.update(reachable=False, error=f"{watched.name}: lost the gateway")
+            watched.update(
+                reachable=False, error=f"{watched.name}: lost the connection to the cobot."
+            )
         finally:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(client.disconnect(), 2)
@@ -232,3 +243,11 @@ class Monitor:
                         await sync_to_async(cobot_states.remember)(watched.state)
                     except Exception:
                         logger.exception("Could not broadcast %s's state", watched.name)
+
+
+def _credentials(watched: Watched) -> tuple[str, str] | None:
+    """The cobot's credentials, from a secret of its own organisation only."""
+    try:
+        return credentials_for(watched.name, watched.organisation, watched.credentials_source)
+    finally:
+        connections.close_all()  # read from a worker thread: hold no connection after

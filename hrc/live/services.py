@@ -45,10 +45,11 @@ class StopError(Exception):
 
 
 def stop_cell(organisation: Organisation, cell: str, *, by: User) -> CellStop:
-    """Holds every active cobot of the cell ("" the whole floor) and pauses its program.
+    """Holds every active cobot of the organisation's cell and pauses its program.
 
     A second STOP of a stopped cell returns the first one. The caller checks
-    that `by` is a member of the organisation.
+    that `by` is a member of the organisation and that `cell` is one of its
+    cells; an empty cell raises ValueError.
     """
     with transaction.atomic():
         existing = _active(organisation, cell)
@@ -122,10 +123,13 @@ def _active(organisation: Organisation, cell: str) -> CellStop | None:
 
 
 def _cell_cobots(organisation: Organisation, cell: str) -> list[Cobot]:
-    cobots = Cobot.objects.select_for_update(no_key=True).filter(
-        organisation=organisation, is_active=True
+    if not cell:
+        raise ValueError("A STOP names its cell; an empty one would match cobots of no cell.")
+    return list(
+        Cobot.objects.select_for_update(no_key=True).filter(
+            organisation=organisation, cell=cell, is_active=True
+        )
     )
-    return list(cobots.filter(cell=cell) if cell else cobots)
 
 
 def _command_all(cobots: list[Cobot], command: Callable[[Cobot], str]) -> dict[str, str]:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import dj_database_url
 
-from hrc.settings.env import env_bool, env_list, env_str, env_url
+from hrc.settings.env import env_bool, env_list, env_networks, env_str, env_url
 
 BASE_DIR = Path(__file__).resolve().parent.parent.parent
 # Where the embedded defaults keep their files (the SQLite database, the demo's logs, the
@@ -267,6 +267,12 @@ SPECTACULAR_SETTINGS = {
 HRC_PKI_DIR = Path(env_str("HRC_PKI_DIR") or VAR_DIR / "pki")
 # The simulator's controller state, so a simulated cobot survives a gateway restart.
 HRC_SIM_STATE_DIR = Path(env_str("HRC_SIM_STATE_DIR") or VAR_DIR / "cobots")
+# The networks cobot endpoints may be on (comma-separated CIDRs, e.g. 10.20.0.0/16); an endpoint
+# elsewhere is refused at registration and never connected to. Unset: no restriction.
+HRC_COBOT_NETWORKS = env_networks("HRC_COBOT_NETWORKS")
+# The key the cobots' credentials secrets are encrypted with (hrc.cobots.secrets); unset, one is
+# derived from SECRET_KEY. Set it apart to rotate SECRET_KEY without losing the secrets.
+HRC_SECRETS_KEY = env_str("HRC_SECRETS_KEY") or ""
 
 # Running cases (hrc.cases.jobs). Seconds unless named otherwise.
 # The sweeper finds expired leases and jobs whose message the broker lost.

@@ -4,6 +4,7 @@ Each reader names the variable in its error, so a misconfigured deployment
 fails at start-up with a message that says what to fix, not deep in a request.
 """
 
+import ipaddress
 import os
 from urllib.parse import urlparse
 
@@ -55,3 +56,16 @@ def env_url(name: str, schemes: set[str]) -> str | None:
         allowed = ", ".join(sorted(schemes))
         raise ImproperlyConfigured(f"{name} must be a URL with scheme {allowed}, got {value!r}")
     return value
+
+
+def env_networks(name: str) -> list[ipaddress.IPv4Network | ipaddress.IPv6Network]:
+    """Reads comma-separated CIDRs (10.0.0.0/8, fd00::/8); rejects anything else."""
+    networks = []
+    for item in env_list(name, []):
+        try:
+            networks.append(ipaddress.ip_network(item, strict=False))
+        except ValueError:
+            raise ImproperlyConfigured(
+                f"{name} must list networks in CIDR form (e.g. 10.0.0.0/8), got {item!r}"
+            ) from None
+    return networks

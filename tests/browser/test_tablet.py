@@ -163,12 +163,13 @@ def test_an_operator_sees_the_task_appear_completes_it_and_the_cobot_goes_on(
     arm: SyncDriver,
     screenshot: Screenshot,
 ) -> None:
-    cobot = factories.make_cobot(organisation, name="cellarm", endpoint=gateway.endpoint)
+    # In cell A: a STOP names the cell it stops (the whole floor's tablet has none to stop).
+    cobot = factories.make_cobot(organisation, name="cellarm", endpoint=gateway.endpoint, cell="A")
     cell.monitor.start()
     url = cell.server.url
     page = tablet.new_page()
     _sign_in(page, url, operator)
-    page.goto(f"{url}/tablet/")
+    page.goto(f"{url}/tablet/A/")
     expect(page.locator(".connection")).to_have_text("Live")
     expect(page.locator(f'.cobot[data-cobot="{cobot.pk}"] dd.mode')).to_have_text(
         "Running", timeout=LIVE_MS

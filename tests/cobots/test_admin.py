@@ -1,5 +1,7 @@
 from django.test import Client
 
+from hrc.cobots import services
+from hrc.cobots.drivers.base import unreachable_message
 from hrc.cobots.gateway.launcher import GatewayProcess, free_port
 from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
@@ -24,17 +26,20 @@ def test_the_add_page_explains_where_credentials_come_from(staff_client: Client)
 
 
 def test_the_admin_registers_a_cobot(staff_client: Client, organisation: Organisation) -> None:
+    services.set_credentials_secret(
+        organisation, "ur10", username="hrc", password="hunter2", by=None
+    )
     data = {
         "organisation": str(organisation.pk),
         "name": "ur10",
         "is_active": "on",
         "driver": "ur",
         "endpoint": "opc.tcp://ur10:4840",
-        "credentials_source": "env:UR10_PASSWORD",
+        "credentials_source": "secret:ur10",
     }
     response = staff_client.post("/admin/cobots/cobot/add/", data)
     assert response.status_code == 302, response.content.decode()[:3000]
-    assert Cobot.objects.get(name="ur10").credentials_source == "env:UR10_PASSWORD"
+    assert Cobot.objects.get(name="ur10").credentials_source == "secret:ur10"
 
 
 def test_the_admin_refuses_a_secret_as_credentials_source(
@@ -73,7 +78,7 @@ def test_the_connection_test_says_why_a_cobot_does_not_answer(
     cobot = factories.make_cobot(organisation, endpoint=f"opc.tcp://127.0.0.1:{free_port()}")
     state = staff_client.get(f"/admin/cobots/cobot/{cobot.pk}/state/").json()
     assert state["reachable"] is False
-    assert "cannot reach the gateway" in state["error"]
+    assert state["error"] == unreachable_message(cobot.name)
     response = staff_client.post(f"/admin/cobots/cobot/{cobot.pk}/test-connection/", follow=True)
     assert "did not answer" in response.content.decode()
 

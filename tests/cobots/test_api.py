@@ -17,7 +17,7 @@ NEW_COBOT: dict[str, Any] = {
     "name": "cobot9",
     "driver": "ur",
     "endpoint": "opc.tcp://ur10.plant.local:4840",
-    "credentials_source": "env:UR10_PASSWORD",
+    "credentials_source": "none",
 }
 
 

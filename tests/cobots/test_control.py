@@ -19,6 +19,7 @@ from hrc.cases.choices import JobState
 from hrc.cases.models import Job
 from hrc.cobots import urua
 from hrc.cobots.choices import CommandOutcome
+from hrc.cobots.drivers.base import unreachable_message
 from hrc.cobots.drivers.runner import driver_for_cobot
 from hrc.cobots.gateway.launcher import GatewayProcess, free_port
 from hrc.cobots.models import Cobot, CobotCommand
@@ -251,7 +252,7 @@ def test_an_unreachable_cobot_is_503_recorded_as_failed(
     response = post(engineer_client, cobot, "power-on", CONFIRMED)
 
     assert response.status_code == 503
-    assert "127.0.0.1" in response.data["detail"]
+    assert unreachable_message(cobot.name) in response.data["detail"]
     assert response.data["command"]["outcome"] == CommandOutcome.FAILED
     registers = engineer_client.get(f"/api/cobots/{cobot.pk}/registers/?names=Bit64")
     assert registers.status_code == 503

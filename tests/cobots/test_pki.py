@@ -452,71 +452,7 @@ def test_a_user_name_the_secret_format_cannot_carry_is_refused(
         pki.add_gateway_user(tmp_path, COBOT, username, PASSWORD)
 
 
-# --- Credentials and the --insecure rule ---------------------------------------
-
-
-def test_parse_credentials_splits_at_the_first_colon() -> None:
-    assert pki.parse_credentials("driver:pa:ss\n") == ("driver", "pa:ss")
-    assert pki.parse_credentials("driver: spaced \r\n") == ("driver", " spaced ")
-
-
-@pytest.mark.parametrize("secret", ["hunter2", ":hunter2", "driver:", ""])
-def test_parse_credentials_refuses_a_malformed_secret_without_quoting_it(secret: str) -> None:
-    with pytest.raises(PkiError) as raised:
-        pki.parse_credentials(secret)
-    assert "hunter2" not in str(raised.value)
-
-
-def test_read_credentials_none_means_no_credentials() -> None:
-    assert pki.read_credentials("none") is None
-
-
-def test_read_credentials_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("HRC_TEST_COBOT_SECRET", "driver:hunter2")
-    assert pki.read_credentials("env:HRC_TEST_COBOT_SECRET") == ("driver", "hunter2")
-
-
-def test_read_credentials_names_a_missing_variable(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.delenv("HRC_TEST_COBOT_SECRET", raising=False)
-    with pytest.raises(PkiError, match="environment variable HRC_TEST_COBOT_SECRET is not set"):
-        pki.read_credentials("env:HRC_TEST_COBOT_SECRET")
-
-
-def test_read_credentials_names_a_malformed_variable_not_its_value(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    monkeypatch.setenv("HRC_TEST_COBOT_SECRET", "hunter2")
-    with pytest.raises(PkiError, match="HRC_TEST_COBOT_SECRET") as raised:
-        pki.read_credentials("env:HRC_TEST_COBOT_SECRET")
-    assert "hunter2" not in str(raised.value)
-
-
-def test_read_credentials_from_a_file(tmp_path: Path) -> None:
-    secret = tmp_path / "cobot1"
-    secret.write_text("driver:hunter2\n")
-    assert pki.read_credentials(f"file:{secret}") == ("driver", "hunter2")
-
-
-def test_read_credentials_names_a_missing_file(tmp_path: Path) -> None:
-    with pytest.raises(PkiError, match=f"credentials file {tmp_path}/absent: No such file"):
-        pki.read_credentials(f"file:{tmp_path}/absent")
-
-
-def test_read_credentials_names_a_malformed_file_not_its_content(tmp_path: Path) -> None:
-    secret = tmp_path / "cobot1"
-    secret.write_text("hunter2\n")
-    with pytest.raises(PkiError, match=str(secret)) as raised:
-        pki.read_credentials(f"file:{secret}")
-    assert "hunter2" not in str(raised.value)
-
-
-@pytest.mark.parametrize("source", ["hunter2", "driver:hunter2", "env:", "file:relative/hunter2"])
-def test_read_credentials_refuses_an_unknown_source_without_quoting_it(source: str) -> None:
-    with pytest.raises(
-        PkiError, match="'none', 'env:VARIABLE_NAME' or 'file:/absolute/path'"
-    ) as raised:
-        pki.read_credentials(source)
-    assert "hunter2" not in str(raised.value)
+# --- The --insecure rule ------------------------------------------------------------
 
 
 @pytest.mark.parametrize(

@@ -32,13 +32,22 @@ def test_other_endpoints_are_refused(endpoint: str) -> None:
         validate_endpoint(endpoint)
 
 
-@pytest.mark.parametrize("source", ["none", "env:UR_PASSWORD", "file:/run/secrets/cobot1"])
+@pytest.mark.parametrize("source", ["none", "secret:cobot1", "secret:ur10.plant-A_2"])
 def test_credentials_references_are_accepted(source: str) -> None:
     validate_credentials_source(source)
 
 
+@pytest.mark.parametrize("source", ["env:COBOTS_CREDENTIALS", "file:/run/secrets/cobot1"])
+def test_the_workers_environment_and_files_are_refused_with_what_to_do_instead(
+    source: str,
+) -> None:
+    with pytest.raises(ValidationError, match="creates a named credentials secret") as refused:
+        validate_credentials_source(source)
+    assert "secret:NAME" in refused.value.messages[0]
+
+
 @pytest.mark.parametrize(
-    "source", ["hunter2", "env:", "env:NOT-A-NAME", "file:relative/path", "none:x", ""]
+    "source", ["hunter2", "env:", "secret:", "secret:a b", "secret:../x", "none:x", ""]
 )
 def test_anything_that_might_be_a_secret_is_refused(source: str) -> None:
     with pytest.raises(ValidationError):

@@ -19,6 +19,7 @@ from hrc.cobots.drivers.base import Fence, StepCommand
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot
+from hrc.live import services
 from hrc.live.consumers import STATE_INTERVAL
 from hrc.live.models import CellStop
 from hrc.organisations import services as organisation_services
@@ -225,6 +226,36 @@ def test_a_cell_the_organisation_does_not_have_cannot_be_stopped_or_resumed(
     assert not CellStop.objects.exists()
     cobot.refresh_from_db()
     assert cobot.stopped_at is None
+
+
+@pytest.mark.parametrize("body", [{"cell": ""}, {}], ids=["empty cell", "no cell"])
+@pytest.mark.parametrize("action", ["stop", "resume"])
+def test_a_stop_or_resume_without_a_named_cell_is_a_400_naming_cell(
+    organisation: Organisation,
+    other_organisation: Organisation,
+    operator: User,
+    body: dict[str, str],
+    action: str,
+) -> None:
+    # Cobots of no cell, ours and another organisation's: an empty cell once matched them.
+    ours = factories.make_cobot(organisation)
+    theirs = factories.make_cobot(other_organisation)
+    client = APIClient()
+    client.force_authenticate(operator)
+
+    refused = client.post(f"/api/cells/{action}/", {**body, "confirm": True}, format="json")
+
+    assert refused.status_code == 400
+    assert "Name the cell" in refused.json()["fields"]["cell"][0]
+    assert not CellStop.objects.exists()
+    assert not Cobot.objects.filter(pk__in=[ours.pk, theirs.pk], stopped_at__isnull=False).exists()
+
+
+def test_the_stop_service_refuses_an_empty_cell(organisation: Organisation, operator: User) -> None:
+    factories.make_cobot(organisation)
+    with pytest.raises(ValueError, match="names its cell"):
+        services.stop_cell(organisation, "", by=operator)
+    assert not CellStop.objects.exists()
 
 
 def test_a_quiet_cobots_subscription_is_kept_not_recreated(

@@ -166,14 +166,11 @@ def test_a_broken_example_is_reported_and_the_others_still_load(tmp_path: Path) 
 @pytest.mark.django_db
 def test_the_cobots_can_point_at_the_compose_gateways() -> None:
     """What docker/README.md tells a person to run in the compose set-up."""
-    _load_demo(
-        "--cobot-endpoint", "opc.tcp://gateway-{cobot}:4840",
-        "--cobot-credentials", "env:{COBOT}_CREDENTIALS",
-    )  # fmt: skip
+    _load_demo("--cobot-endpoint", "opc.tcp://gateway-{cobot}:4840")
     cobots = Cobot.objects.filter(organisation__slug="demo-plant")
     assert sorted(cobots.values_list("name", "endpoint", "credentials_source")) == [
-        ("cobot1", "opc.tcp://gateway-cobot1:4840", "env:COBOT1_CREDENTIALS"),
-        ("cobot2", "opc.tcp://gateway-cobot2:4840", "env:COBOT2_CREDENTIALS"),
+        ("cobot1", "opc.tcp://gateway-cobot1:4840", "none"),
+        ("cobot2", "opc.tcp://gateway-cobot2:4840", "none"),
     ]
     _load_demo()  # and back to make demo's loopback gateways
     assert sorted(cobots.values_list("endpoint", "credentials_source")) == [
@@ -190,4 +187,7 @@ def test_a_bad_cobot_template_is_refused_naming_what_is_wrong() -> None:
         _load_demo("--cobot-endpoint", "http://gateway-{cobot}:4840")
     with pytest.raises(CommandError, match="credentials source"):
         _load_demo("--cobot-credentials", "secret-password")
+    # A worker's variable would be every organisation's: cobots sign in with a named secret.
+    with pytest.raises(CommandError, match="named credentials secret"):
+        _load_demo("--cobot-credentials", "env:{COBOT}_CREDENTIALS")
     assert not Organisation.objects.filter(slug="demo-plant").exists()

@@ -4,7 +4,7 @@ from typing import Any
 
 from rest_framework import serializers
 
-from hrc.cobots.models import Cobot, CobotCommand
+from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
 from hrc.organisations.api.serializers import MemberOrganisationField
 
 
@@ -106,3 +106,29 @@ class CobotStateSerializer(serializers.Serializer[dict[str, Any]]):
     ProgramState = serializers.CharField(required=False)
     CurrentProgram = serializers.CharField(required=False)
     LastError = serializers.CharField(required=False)
+
+
+class CredentialsSecretSerializer(serializers.ModelSerializer[CredentialsSecret]):
+    """A credentials secret as shown: its name and who set it, never the user name or password."""
+
+    updated_by: serializers.SlugRelatedField[Any] = serializers.SlugRelatedField(
+        slug_field="username", read_only=True, allow_null=True
+    )
+
+    class Meta:
+        model = CredentialsSecret
+        fields = ["id", "organisation", "name", "updated_by", "updated_at"]
+        read_only_fields = fields
+
+
+class SetCredentialsSecretSerializer(serializers.Serializer[dict[str, Any]]):
+    """Creates a secret or replaces the one of that name; write-only."""
+
+    organisation = serializers.IntegerField(
+        required=False, help_text="Needed only when you are an admin of several organisations."
+    )
+    name = serializers.CharField(max_length=64, help_text="Cobots use it as 'secret:NAME'.")
+    username = serializers.CharField(max_length=64, write_only=True)
+    password = serializers.CharField(
+        max_length=1024, write_only=True, trim_whitespace=False, style={"input_type": "password"}
+    )

@@ -35,8 +35,9 @@ from typing import Any, TypeVar
 from django.db.models import QuerySet
 from drf_spectacular.types import OpenApiTypes
 from drf_spectacular.utils import OpenApiParameter, extend_schema
-from rest_framework import serializers, viewsets
+from rest_framework import mixins, serializers, status, viewsets
 from rest_framework.decorators import action
+from rest_framework.exceptions import PermissionDenied
 from rest_framework.request import Request
 from rest_framework.response import Response
 
@@ -49,12 +50,17 @@ from hrc.cobots.api.serializers import (
     CobotStateSerializer,
     CommandRefusalSerializer,
     ControlRequestSerializer,
+    CredentialsSecretSerializer,
     LoadProgramRequestSerializer,
     RegistersSerializer,
+    SetCredentialsSecretSerializer,
 )
 from hrc.cobots.choices import ControlCommand
-from hrc.cobots.models import Cobot, CobotCommand
+from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
 from hrc.cobots.selectors import cobots_visible_to, commands_of, live_state
+from hrc.organisations.choices import Role
+from hrc.organisations.models import Organisation
+from hrc.organisations.selectors import is_admin_of, memberships_of, organisations_of
 
 COMMAND_RESPONSES: dict[int | str, Any] = {
     200: CobotCommandSerializer,
@@ -225,3 +231,86 @@ class CobotViewSet(viewsets.ModelViewSet[Cobot]):
     def commands(self, request: Request, pk: str | None = None) -> Response:
         page: list[CobotCommand] = self.paginate_queryset(commands_of(self.get_object()))  # type: ignore[arg-type,assignment]
         return self.get_paginated_response(CobotCommandSerializer(page, many=True).data)
+
+
+ADMINS_ONLY = "Only admins of the organisation set or delete its cobots' credentials."
+
+
+class MembersReadAdminsWrite(MembersReadWritersWrite):
+    """Members see the secrets' names (to choose one for a cobot); only admins write."""
+
+    message = ADMINS_ONLY
+
+    def has_permission(self, request: Request, view: Any) -> bool:
+        return bool(request.user and request.user.is_authenticated)
+
+    def has_object_permission(self, request: Request, view: Any, obj: Any) -> bool:
+        if request.method in ("GET", "HEAD", "OPTIONS"):
+            return True
+        return is_admin_of(request.user, obj.organisation_id)
+
+
+class CredentialsSecretViewSet(
+    mixins.ListModelMixin,
+    mixins.RetrieveModelMixin,
+    mixins.DestroyModelMixin,
+    viewsets.GenericViewSet[CredentialsSecret],
+):
+    """/api/cobot-credentials/: your organisations' credentials secrets, by name.
+
+    POST sets one (creates it, or replaces the user name and password of the one
+    of that name): admins of the organisation only. Nothing here ever returns a
+    user name or password; another organisation's secret is 404.
+    """
+
+    serializer_class = CredentialsSecretSerializer
+    permission_classes = [MembersReadAdminsWrite]
+
+    def get_queryset(self) -> QuerySet[CredentialsSecret]:
+        return (
+            CredentialsSecret.objects.filter(organisation__in=organisations_of(self.request.user))
+            .select_related("updated_by")
+            .order_by("organisation_id", "name")
+        )
+
+    @extend_schema(
+        request=SetCredentialsSecretSerializer,
+        responses={201: CredentialsSecretSerializer, 200: CredentialsSecretSerializer},
+    )
+    def create(self, request: Request, *args: Any, **kwargs: Any) -> Response:
+        body = SetCredentialsSecretSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        organisation = _admin_organisation(request, body.validated_data.get("organisation"))
+        name = body.validated_data["name"]
+        existed = CredentialsSecret.objects.filter(organisation=organisation, name=name).exists()
+        secret = services.set_credentials_secret(
+            organisation,
+            name,
+            username=body.validated_data["username"],
+            password=body.validated_data["password"],
+            by=request.user,  # type: ignore[arg-type]  # authenticated: the permission
+        )
+        code = status.HTTP_200_OK if existed else status.HTTP_201_CREATED
+        return Response(CredentialsSecretSerializer(secret).data, status=code)
+
+    def perform_destroy(self, instance: CredentialsSecret) -> None:
+        services.delete_credentials_secret(instance)
+
+
+def _admin_organisation(request: Request, requested: int | None) -> Organisation:
+    """The organisation a secret is set in: the requested one, or the user's only one as admin."""
+    admin_of = memberships_of(request.user).filter(role=Role.ADMIN)
+    if requested is not None:
+        if not organisations_of(request.user).filter(pk=requested).exists():
+            raise serializers.ValidationError(
+                {"organisation": f"You are not a member of organisation {requested}."}
+            )
+        admin_of = admin_of.filter(organisation_id=requested)
+    found = [m.organisation for m in admin_of[:2]]
+    if not found:
+        raise PermissionDenied(ADMINS_ONLY)
+    if len(found) > 1:
+        raise serializers.ValidationError(
+            {"organisation": "You are an admin of several organisations: say which one (its id)."}
+        )
+    return found[0]

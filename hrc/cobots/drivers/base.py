@@ -34,6 +34,17 @@ class CobotUnreachable(DriverError):
     transient = True
 
 
+def unreachable_message(cobot: str) -> str:
+    """What a person reads whenever a session to the cobot cannot be opened.
+
+    The same words whatever is (or is not) listening at the endpoint, refused,
+    silent, not OPC UA, or refusing the secure channel: anything more would let
+    an engineer who registers an endpoint scan ports with it. The detail goes to
+    the server's log.
+    """
+    return f"Cannot reach cobot {cobot} at its endpoint."
+
+
 class StepTimeout(DriverError):
     """The cobot did not acknowledge in time; the step is in doubt, so retry with the same token."""
 
@@ -48,6 +59,11 @@ class CobotBusy(DriverError):
 
 class CommandRefused(DriverError):
     """The gateway refused the command (bad status); its message says why."""
+
+
+class DriverNotSetUp(DriverError):
+    """This installation's own certificate, key or pinned gateway certificate is missing:
+    nothing was sent, and a person must make them (`manage.py cobot_certificates`)."""
 
 
 class InvalidCommand(DriverError):

@@ -17,11 +17,11 @@ from typing import Any, TypeVar
 
 from django.conf import settings
 
+from hrc.cobots.credentials import CredentialsError, credentials_for
 from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import CobotUnreachable, DriverError, StepCommand, StepResult
 from hrc.cobots.drivers.opcua.driver import ClientSecurity, OpcUaDriver
 from hrc.cobots.models import Cobot
-from hrc.cobots.pki import PkiError, read_credentials
 
 T = TypeVar("T")
 
@@ -106,7 +106,9 @@ def driver_for(
     """The process's driver for a cobot at an endpoint, created on first use.
 
     `options` (timeouts) apply when the driver is created; later calls get the same driver.
+    It connects only within settings.HRC_COBOT_NETWORKS when that is set.
     """
+    options.setdefault("networks", settings.HRC_COBOT_NETWORKS)
     key = (name, endpoint, security)
     loop = _LOOP.loop()
     driver = _LOOP.drivers.get(key)
@@ -129,9 +131,9 @@ def driver_for_cobot(cobot: Cobot, **options: Any) -> SyncDriver:
     SignAndEncrypt with the installation's certificates.
     """
     try:
-        credentials = read_credentials(cobot.credentials_source)
-    except PkiError as error:
-        raise DriverError(f"{cobot.name}: {error}") from None
+        credentials = credentials_for(cobot.name, cobot.organisation_id, cobot.credentials_source)
+    except CredentialsError as error:
+        raise DriverError(str(error)) from None
     security = None
     if credentials is not None:
         username, password = credentials

@@ -22,6 +22,7 @@ from typing import Any
 from asyncua import Server, ua
 
 from hrc.cobots import urua
+from hrc.cobots.endpoints import EndpointError, bind_host, url_host
 from hrc.cobots.gateway.address_space import AddressSpace
 from hrc.cobots.gateway.backend import (
     Backend,
@@ -60,6 +61,10 @@ class Gateway:
         port: int = 4841,
         secure: Secure | None = None,
     ) -> None:
+        try:
+            host = bind_host(host)
+        except EndpointError as error:
+            raise GatewayError(f"Cannot serve {name} on that host: {error}") from None
         if secure is None and not is_loopback(host):
             raise GatewayError(
                 f"Refusing to serve {name} without security on {host}: --insecure is for "
@@ -80,12 +85,12 @@ class Gateway:
     def endpoint(self) -> str:
         """The URL clients connect to; the real port once started with port 0."""
         port = self.server.bserver.port if self.server.bserver else self.port
-        return f"opc.tcp://{self.host}:{port}"
+        return f"opc.tcp://{url_host(self.host)}:{port}"
 
     async def start(self) -> None:
         """Builds the address space, starts the backend, then serves clients."""
         await self.server.init()
-        self.server.set_endpoint(f"opc.tcp://{self.host}:{self.port}")
+        self.server.set_endpoint(f"opc.tcp://{url_host(self.host)}:{self.port}")
         self.server.set_server_name(f"hrc cobot gateway {self.name}")
         if self._secure is None:
             self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])

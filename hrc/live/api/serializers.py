@@ -13,7 +13,7 @@ class CellRequestSerializer(serializers.Serializer[dict[str, Any]]):
     )
     cell = serializers.CharField(
         required=False, allow_blank=True, default="", max_length=50,
-        validators=[validate_cell], help_text="The cell; empty for the whole floor.",
+        validators=[validate_cell], help_text="The cell, one of the organisation's (required).",
     )  # fmt: skip
 
 

@@ -3,7 +3,7 @@
 Any member of the organisation may stop its cells and resume them (operators
 above all: they stand at the cell). A non-member is told the organisation is
 not theirs (400), as target_organisation does. A cell the organisation does
-not have is refused (400 naming `cell`): nothing is stopped, nothing written.
+not have, or none, is refused (400 naming `cell`): nothing is stopped, nothing written.
 """
 
 from typing import Any
@@ -75,6 +75,11 @@ def _organisation(request: Request, requested: Any) -> Organisation:
 
 
 def _cell(organisation: Organisation, cell: str) -> str:
+    if not cell:
+        # Never "every cobot": a STOP names the cell it is for, so no empty value can ever
+        # reach cobots beyond the one cell of the one organisation.
+        message = f"Name the cell to stop or resume: one of {organisation.name}'s cells."
+        raise Rejected({"detail": message, "fields": {"cell": [message]}})
     if not selectors.is_cell(organisation.pk, cell):
         message = f"There is no cell {cell!r} in {organisation.name}."
         raise Rejected({"detail": message, "fields": {"cell": [message]}})

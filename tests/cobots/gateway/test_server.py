@@ -218,3 +218,28 @@ async def _poll(variable, expected: object, timeout: float = 10) -> None:  # typ
     while await variable.read_value() != expected:
         assert time.monotonic() < deadline, f"{variable} never became {expected!r}"
         await asyncio.sleep(0.02)
+
+
+async def test_an_ipv4_mapped_loopback_host_is_served_as_plain_ipv4(tmp_path: Path) -> None:
+    backend = SimBackend("cobot1", state_file=tmp_path / "sim.json", time_scale=0)
+    gateway = Gateway("cobot1", backend, host="::ffff:127.0.0.1", port=0)
+    await gateway.start()
+    try:
+        assert gateway.endpoint.startswith("opc.tcp://127.0.0.1:")
+        async with Client(gateway.endpoint) as client:
+            mode = client.get_node(urua.node_id("cobot1", urua.STATE_ROBOT_MODE))
+            assert await mode.read_value()
+    finally:
+        await gateway.stop()
+
+
+def test_an_ipv6_host_is_written_in_brackets_in_the_endpoint(tmp_path: Path) -> None:
+    backend = SimBackend("cobot1", state_file=tmp_path / "sim.json")
+    assert Gateway("cobot1", backend, host="[::1]", port=4841).endpoint == "opc.tcp://[::1]:4841"
+
+
+@pytest.mark.parametrize("host", ["a:b", "exa mple", "::ffff:127.0.0.1:80"])
+def test_a_host_that_is_no_host_is_refused_with_a_message(tmp_path: Path, host: str) -> None:
+    backend = SimBackend("cobot1", state_file=tmp_path / "sim.json")
+    with pytest.raises(GatewayError, match="neither a host name nor an IP address"):
+        Gateway("cobot1", backend, host=host, secure=None)

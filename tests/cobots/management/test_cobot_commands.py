@@ -48,7 +48,9 @@ def test_cobot_step_reports_a_protective_stop_clearly(
 
 def test_cobot_step_reports_a_dead_gateway_without_hanging() -> None:
     endpoint = f"opc.tcp://127.0.0.1:{free_port()}"
-    with pytest.raises(CommandError, match=r"cannot reach the gateway.*a retry may help"):
+    with pytest.raises(
+        CommandError, match=r"Cannot reach cobot cobot1 at its endpoint.*a retry may help"
+    ):
         run(
             "cobot_step",
             "cobot1",
@@ -92,6 +94,12 @@ def test_cobot_call_reads_and_wrong_methods_are_named(
     assert "ProgramState: Paused" in output
     with pytest.raises(CommandError, match="no node 'Launch'"):
         run("cobot_call", "cobot1", "--endpoint", gateway.endpoint, "Launch")
+
+
+@pytest.mark.parametrize("host", ["a:b", "::ffff:127.0.0.1:80", "[::ffff:127.0.0.1"])
+def test_cobot_gateway_names_a_host_that_is_no_host_without_a_traceback(host: str) -> None:
+    with pytest.raises(CommandError, match=r"--host: .* is neither a host name nor an IP address"):
+        run("cobot_gateway", "--name", "cobot1", "--insecure", "--host", host)
 
 
 def test_cobot_gateway_refuses_insecure_off_loopback(tmp_path: Path) -> None:

@@ -39,11 +39,14 @@ from hrc.cobots.drivers.base import (
     CobotUnreachable,
     CommandRefused,
     DriverError,
+    DriverNotSetUp,
     InvalidCommand,
     StepCommand,
     StepResult,
     StepTimeout,
+    unreachable_message,
 )
+from hrc.cobots.endpoints import EndpointError, IPNetwork, check_networks
 from hrc.cobots.pki import PkiError, check_gateway_certificate, secure_client
 
 logger = logging.getLogger(__name__)
@@ -126,8 +129,11 @@ class OpcUaDriver(CobotDriver):
         publishing_interval: float = 0.0,
         backoff: tuple[float, float] = (0.05, 5.0),
         page: str = "",
+        networks: Sequence[IPNetwork] = (),
     ) -> None:
         self.name = name
+        # HRC_COBOT_NETWORKS: the endpoint is resolved and checked before every connection.
+        self.networks = tuple(networks)
         # The cobot's page in hrc, named in what a person must do (readiness.not_ready).
         self.page = page
         self.endpoint = endpoint
@@ -154,7 +160,7 @@ class OpcUaDriver(CobotDriver):
         self._cache_behind = False
         self._session_lock = asyncio.Lock()
         # Why the last connection attempt failed, for errors raised while backing off.
-        self.last_failure = f"{name}: the gateway at {endpoint} has not been reached yet"
+        self.last_failure = unreachable_message(name)
 
     # Session -----------------------------------------------------------------
 
@@ -197,7 +203,25 @@ class OpcUaDriver(CobotDriver):
         self._delay = min(self._delay * 2, self._backoff_max)
 
     async def _open(self, deadline: float) -> None:
+        """Opens a session; every failure before it is open reads the same (unreachable_message)."""
         await self.close()
+        try:
+            await check_networks(self.endpoint, self.networks)
+        except EndpointError as error:
+            logger.warning("Not connecting to cobot %s at %s: %s", self.name, self.endpoint, error)
+            raise CommandRefused(
+                f"{self.name}: not connected: its endpoint is outside the networks cobots may "
+                "be on (HRC_COBOT_NETWORKS)."
+            ) from None
+        try:
+            await self._connect(deadline)
+        except (DriverError, _SessionLost) as error:
+            if isinstance(error, DriverNotSetUp):
+                raise
+            logger.warning("Cannot reach cobot %s at %s: %s", self.name, self.endpoint, error)
+            raise CobotUnreachable(unreachable_message(self.name)) from None
+
+    async def _connect(self, deadline: float) -> None:
         client = Client(self.endpoint, timeout=self.request_timeout)
         # asyncua asks for an hour and warns when the server grants less; ours grants ten minutes,
         # and the session is kept alive by its subscription anyway.
@@ -213,7 +237,8 @@ class OpcUaDriver(CobotDriver):
                     self.security.password,
                 )
             except PkiError as error:
-                raise CommandRefused(str(error)) from None
+                # This installation's own files are missing: nothing learnt about the endpoint.
+                raise DriverNotSetUp(str(error)) from None
         client.connection_lost_callback = self._on_connection_lost
         timeout = max(0.01, min(self.connect_timeout, deadline - time.monotonic()))
         try:
@@ -667,9 +692,8 @@ class OpcUaDriver(CobotDriver):
 
     def _unreachable(self, error: BaseException) -> CobotUnreachable:
         self._lost(error)
-        return CobotUnreachable(
-            f"{self.name}: lost the gateway at {self.endpoint} ({_describe(error)})."
-        )
+        logger.warning("Lost cobot %s at %s: %s", self.name, self.endpoint, _describe(error))
+        return CobotUnreachable(f"{self.name}: lost the connection to the cobot.")
 
 
 class _Handler:

@@ -15,6 +15,7 @@ from typing import Any
 from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
+from hrc.cobots.endpoints import EndpointError, bind_host
 from hrc.cobots.gateway.backend import Backend, CommandFailed
 from hrc.cobots.gateway.server import Gateway, GatewayError
 from hrc.cobots.pki import PkiError, check_cobot_name, is_loopback, secure_server
@@ -69,6 +70,11 @@ class Command(BaseCommand):
             check_cobot_name(name)
         except PkiError as error:
             raise CommandError(str(error)) from None
+        try:
+            # An address is bound in its plain form: "::ffff:127.0.0.1" as 127.0.0.1, "[::1]" as ::1.
+            options["host"] = bind_host(options["host"])
+        except EndpointError as error:
+            raise CommandError(f"--host: {error}") from None
         if options["insecure"] and not is_loopback(options["host"]):
             raise CommandError(
                 f"--insecure serves {name} to anyone who can reach it, so it is allowed on "

@@ -18,6 +18,7 @@ from hrc.cobots.drivers.base import (
     InvalidCommand,
     StepCommand,
     StepTimeout,
+    unreachable_message,
 )
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
 from hrc.cobots.gateway.launcher import GatewayProcess, free_port
@@ -167,17 +168,21 @@ async def test_a_step_is_refused_when_no_program_plays(driver: OpcUaDriver) -> N
 async def test_a_dead_gateway_is_a_clear_transient_error_not_a_hang() -> None:
     driver = OpcUaDriver("cobot1", f"opc.tcp://127.0.0.1:{free_port()}", connect_timeout=1.0)
     started = time.monotonic()
-    with pytest.raises(CobotUnreachable, match="cannot reach") as unreachable:
+    with pytest.raises(CobotUnreachable, match="Cannot reach cobot cobot1") as unreachable:
         await driver.run_step(StepCommand(step=HOME, fence=Fence(16, 1)), timeout=2.0)
     assert unreachable.value.transient
     assert time.monotonic() - started < 4
     await driver.close()
 
 
-async def test_a_gateway_for_another_cobot_is_named_in_the_error(gateway: GatewayProcess) -> None:
-    driver = OpcUaDriver("cobot9", gateway.endpoint)
-    with pytest.raises(InvalidCommand, match="no cobot named 'cobot9'"):
+async def test_a_gateway_for_another_cobot_reads_as_unreachable_and_is_named_in_the_log(
+    gateway: GatewayProcess, caplog: pytest.LogCaptureFixture
+) -> None:
+    driver = OpcUaDriver("cobot9", gateway.endpoint, connect_timeout=1.0)
+    with pytest.raises(CobotUnreachable) as unreachable:
         await driver.state()
+    assert str(unreachable.value) == unreachable_message("cobot9")
+    assert "no cobot named 'cobot9'" in caplog.text
     await driver.close()
 
 

@@ -9,7 +9,7 @@ import pytest
 from asyncua import Client
 from django.core.management import call_command
 
-from hrc.cobots.drivers.base import CommandRefused, Fence, StepCommand
+from hrc.cobots.drivers.base import CobotUnreachable, Fence, StepCommand, unreachable_message
 from hrc.cobots.drivers.opcua.driver import ClientSecurity, OpcUaDriver
 from hrc.cobots.gateway.launcher import GatewayProcess
 from tests.cobots.simulator import PROGRAM
@@ -51,15 +51,20 @@ async def test_the_driver_runs_a_step_over_an_encrypted_session(
         await driver.close()
 
 
-async def test_a_wrong_password_is_refused_for_good(
-    secure_gateway: GatewayProcess, pki: Path
+async def test_a_wrong_password_reads_as_unreachable_and_is_named_in_the_log(
+    secure_gateway: GatewayProcess, pki: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
+    # Saying "wrong password" would tell an engineer probing ports that a gateway listens there.
     driver = OpcUaDriver(
-        "cobot1", secure_gateway.endpoint, security=ClientSecurity(pki, "hrc-driver", "guess")
+        "cobot1",
+        secure_gateway.endpoint,
+        security=ClientSecurity(pki, "hrc-driver", "guess"),
+        connect_timeout=2.0,
     )
-    with pytest.raises(CommandRefused, match="refused the user name or password") as refused:
+    with pytest.raises(CobotUnreachable) as refused:
         await driver.state()
-    assert not refused.value.transient
+    assert str(refused.value) == unreachable_message("cobot1")
+    assert "refused the user name or password" in caplog.text
     await driver.close()
 
 
