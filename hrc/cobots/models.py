@@ -71,8 +71,8 @@ class Cobot(models.Model):
         validators=[validate_cell],
         help_text=(
             "The work cell the cobot stands in (letters, digits, - and _), registered as one of the "
-            "organisation's cells; that cell's tablet shows and stops its cobots. Empty: the "
-            "organisation's whole floor."
+            "organisation's cells; that cell's tablet shows and stops its cobots. Empty: shown on "
+            "the whole floor's tablet, which has no STOP; give it a cell to stop it from one."
         ),
     )
     stopped_at = models.DateTimeField(

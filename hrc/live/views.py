@@ -43,6 +43,8 @@ def tablet(request: HttpRequest, cell: str = "") -> HttpResponse:
         "cell": cell,
         "cycles": _cycles(request, access, cell) if cell else [],
         "started": request.GET.get("started", ""),
+        # A STOP names its cell: the whole floor's tablet sends people to theirs.
+        "cells": [] if cell else cells_of(access.organisation_id),
     }
     return render(request, "tablet/tablet.html", context)
 

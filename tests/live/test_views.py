@@ -32,6 +32,17 @@ def test_a_cells_tablet_loads_the_live_page(organisation: Organisation, operator
     assert b'aria-label="STOP every cobot of the cell"' in response.content
 
 
+def test_the_whole_floors_tablet_has_no_stop_and_sends_people_to_each_cells(
+    organisation: Organisation, operator: User
+) -> None:
+    # A STOP names its cell: a button here could only be refused.
+    factories.make_cobot(organisation, cell="weld")
+    page = _client(operator).get("/tablet/").content.decode()
+    assert 'class="stop"' not in page
+    assert "STOP is on each cell's tablet" in page
+    assert f'href="/tablet/weld/?organisation={organisation.pk}"' in page
+
+
 def test_an_unknown_cell_says_so_and_lists_the_organisations_cells_with_no_stop(
     organisation: Organisation, other_organisation: Organisation, operator: User
 ) -> None:

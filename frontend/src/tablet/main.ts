@@ -188,7 +188,8 @@ function renderStop(state: LiveState): void {
   const stop = state.stop;
   root.classList.toggle("stopped", stop !== null);
   banner.hidden = resume.hidden = stop === null;
-  $<HTMLButtonElement>(".stop").disabled = stop !== null;
+  const stopButton = root.querySelector<HTMLButtonElement>(".stop");
+  if (stopButton) stopButton.disabled = stop !== null; // the whole floor's tablet has none
   if (stop) {
     const problems = Object.values(stop.problems);
     banner.textContent =
@@ -296,7 +297,7 @@ async function openForm(id: number): Promise<void> {
   dialog.showModal();
 }
 
-$(".stop").addEventListener("click", () => {
+root.querySelector(".stop")?.addEventListener("click", () => {
   void act($(".stop"), "/api/cells/stop/", { organisation: config.organisation, cell: config.cell });
 });
 
