@@ -151,7 +151,15 @@ def guess_by_admin_login(client: Client, username: str, password: str) -> int:
     return client.post("/admin/login/", body).status_code
 
 
-@pytest.mark.parametrize("guess", [guess_by_api, guess_by_login_page, guess_by_admin_login])
+def guess_by_browsable_api_login(client: Client, username: str, password: str) -> int:
+    body = {"username": username, "password": password, "next": "/api/"}
+    return client.post("/api/auth/login/", body).status_code
+
+
+@pytest.mark.parametrize(
+    "guess",
+    [guess_by_api, guess_by_login_page, guess_by_admin_login, guess_by_browsable_api_login],
+)
 def test_twenty_wrong_passwords_from_one_address_in_a_minute_are_locked_out(
     engineer: User, admin: User, guess: object
 ) -> None:
