@@ -21,36 +21,22 @@ processes and Celery's workers, cost no table, and a crashed process's locks
 go with its connection. The embedded SQLite default runs in one process, so
 there a semaphore per organisation does the same.
 
-Checks run in the engine's worker processes, not on the server's threads:
-a check is pure Python that holds the interpreter lock, so on a thread of
-daphne it slowed every other request of that process, and its markings grew
-daphne's memory. The workers (HRC_ENGINE_WORKERS per web process, spawned on
-first use, importing only hrc.engine) take the documents over a pipe; the
-request's thread waits for the answer without holding the lock. Not Celery:
-the editor waits for the report in its request, and a result channel (a row
-to poll) would add a round trip to every check for what a pipe gives at once.
+Checks run in the engine's worker processes (hrc.patterns.engine_workers),
+not on the server's threads. Not Celery: the editor waits for the report in
+its request, and a result channel (a row to poll) would add a round trip to
+every check for what a pipe gives at once.
 """
 
-import multiprocessing
-import os
 import threading
 from collections import defaultdict
 from collections.abc import Iterator
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
-from typing import Any
 
 from django.conf import settings
 from django.db import DatabaseError, connection
 
 from hrc.engine.budget import Budget
-from hrc.engine.check import report_of
-
-Report = dict[str, Any]
-# A worker is replaced after this many checks, so the memory a huge state space took
-# goes back to the system instead of staying with the worker.
-CHECKS_PER_WORKER = 50
+from hrc.patterns.engine_workers import Report, check_in_worker
 
 # High bits of every slot's advisory lock key, so the slots collide with no other
 # advisory lock: the key is this, the slot number and the organisation's id.
@@ -82,40 +68,9 @@ def publish_budget() -> Budget:
 
 
 def checked(document: object, budget: Budget) -> Report:
-    """The engine's check of `document` within `budget`, computed in an engine worker."""
-    try:
-        return _workers().submit(report_of, document, budget).result()
-    except BrokenProcessPool:
-        # A worker died (killed, out of memory): the pool is unusable; a new one tries once more.
-        _reset_workers()
-        return _workers().submit(report_of, document, budget).result()
-
-
-_workers_guard = threading.Lock()
-_pool: tuple[int, ProcessPoolExecutor] | None = None
-
-
-def _workers() -> ProcessPoolExecutor:
-    """This process's pool, made on first use; a forked child (a Celery worker) makes its own."""
-    global _pool
-    with _workers_guard:
-        if _pool is None or _pool[0] != os.getpid():
-            executor = ProcessPoolExecutor(
-                max_workers=settings.HRC_ENGINE_WORKERS,
-                # spawn, not fork: the server's threads and connections stay behind.
-                mp_context=multiprocessing.get_context("spawn"),
-                max_tasks_per_child=CHECKS_PER_WORKER,
-            )
-            _pool = (os.getpid(), executor)
-        return _pool[1]
-
-
-def _reset_workers() -> None:
-    global _pool
-    with _workers_guard:
-        if _pool is not None:
-            _pool[1].shutdown(wait=False, cancel_futures=True)
-        _pool = None
+    """The engine's check of `document` within `budget`, computed in an engine worker
+    (hrc.patterns.engine_workers)."""
+    return check_in_worker(document, budget)
 
 
 @contextmanager

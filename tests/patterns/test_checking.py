@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from django.conf import settings
 
 from hrc.engine.check import report_of
 from hrc.patterns import checking
+from hrc.patterns.engine_workers import worker_pids
 from tests import factories
-
-
-def worker_pids() -> list[int]:
-    processes = checking._workers()._processes.values()  # concurrent.futures keeps them here
-    return [process.pid for process in processes if process.pid is not None]
 
 
 def test_a_check_runs_in_an_engine_worker_and_answers_as_the_engine_does() -> None:
@@ -29,9 +31,45 @@ def test_a_check_runs_in_an_engine_worker_and_answers_as_the_engine_does() -> No
 def test_a_worker_that_died_is_replaced_and_the_check_still_answers() -> None:
     document = factories.valid_document()
     checking.checked(document, checking.interactive_budget())
-    for pid in worker_pids():
+    dead = worker_pids()
+    for pid in dead:
         os.kill(pid, signal.SIGKILL)
 
     report = checking.checked(document, checking.interactive_budget())
 
     assert report["valid"] is True
+    assert not set(dead) & set(worker_pids())
+
+
+PARENT = """
+import sys, time, django
+django.setup()
+from hrc.patterns import checking
+from hrc.patterns.engine_workers import worker_pids
+from tests import factories
+checking.checked(factories.valid_document(), checking.interactive_budget())
+print(worker_pids()[0], flush=True)
+time.sleep(60)
+"""
+
+
+def test_a_worker_dies_with_a_server_killed_outright() -> None:
+    parent = subprocess.Popen(
+        [sys.executable, "-c", PARENT], stdout=subprocess.PIPE, text=True, cwd=settings.BASE_DIR
+    )
+    assert parent.stdout is not None
+    worker = int(parent.stdout.readline())
+    parent.kill()
+    parent.wait()
+    deadline = time.monotonic() + 10
+    while alive(worker) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not alive(worker)
+
+
+def alive(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except FileNotFoundError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"  # a zombie waits only for its reaping
