@@ -94,6 +94,8 @@ _CUT_OFF = """() => {
   for (const el of document.querySelectorAll('body *')) {
     const style = getComputedStyle(el);
     if (style.display === 'none' || style.visibility === 'hidden' || el.closest('svg')) continue;
+    // perfect-scrollbar (ReDoc's menu) hides the overflow and scrolls it itself.
+    if (el.classList.contains('ps')) continue;
     const clipsX = ['hidden', 'clip'].includes(style.overflowX) || style.textOverflow === 'ellipsis';
     const clipsY = ['hidden', 'clip'].includes(style.overflowY);
     if ((clipsX && el.scrollWidth > el.clientWidth + 1) || (clipsY && el.scrollHeight > el.clientHeight + 1)) {
