@@ -14,6 +14,15 @@ from pathlib import Path
 from tests.cases.test_run_pattern_embedded import ROOT, embedded_environment
 
 
+def gateways_of(pid: int) -> list[int]:
+    """The live cobot gateways whose parent is `pid` (not its engine workers), from /proc."""
+    return [
+        child
+        for child in children_of(pid)
+        if b"cobot_gateway" in Path(f"/proc/{child}/cmdline").read_bytes()
+    ]
+
+
 def children_of(pid: int) -> list[int]:
     """The live processes whose parent is `pid`, read from /proc."""
     found = []
@@ -54,7 +63,7 @@ def test_sigterm_stops_the_gateways_run_pattern_started(tmp_path: Path) -> None:
     gateways: list[int] = []
     try:
         deadline = time.monotonic() + 60
-        while not (gateways := children_of(run.pid)) and time.monotonic() < deadline:
+        while not (gateways := gateways_of(run.pid)) and time.monotonic() < deadline:
             assert run.poll() is None, run.stderr.read() if run.stderr else ""
             time.sleep(0.1)
         assert gateways, "run_pattern started no gateway within 60 s"
