@@ -53,6 +53,7 @@ HOSTILE = [
     ("POST", "/api/patterns/check-document/", json.dumps(parallel_lanes(10, 8)).encode()),
 ]
 HOSTILE_REQUESTS = 50
+DROPPED = 0
 
 
 @pytest.mark.django_db(transaction=True)
@@ -74,6 +75,8 @@ def test_after_fifty_hostile_requests_at_once_the_server_still_answers(
                 return int(response.status)
         except urllib.error.HTTPError as refused:
             return refused.code
+        except ConnectionError:
+            return DROPPED  # a hostile request may be cut short; the server must live on
 
     try:
         with ThreadPoolExecutor(HOSTILE_REQUESTS) as pool:

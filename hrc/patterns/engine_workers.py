@@ -7,7 +7,7 @@ memory. Each web process keeps up to HRC_ENGINE_WORKERS workers
 first use, each taking one document at a time over a pipe; the request's
 thread waits for the answer without holding the lock. Plain pipes, not
 multiprocessing: no re-import of the server's main module in the child and no
-resource tracker left behind; a worker dies with its parent (hrc.engine.worker).
+resource tracker left behind; a worker ends with its parent's pipe (hrc.engine.worker).
 
 A worker is replaced after CHECKS_PER_WORKER checks, so the memory a huge
 state space took goes back to the system, and when it dies or overruns its
@@ -17,6 +17,7 @@ budget by OVERRUN_SECONDS (then it is killed).
 from __future__ import annotations
 
 import atexit
+import contextlib
 import json
 import os
 import subprocess
@@ -41,7 +42,7 @@ class EngineWorkerFailed(Exception):
 class _Worker:
     def __init__(self) -> None:
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "hrc.engine.worker", str(os.getpid())],
+            [sys.executable, "-m", "hrc.engine.worker"],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             cwd=settings.BASE_DIR,
@@ -75,7 +76,8 @@ class _Worker:
 
     def stop(self) -> None:
         if self.process.stdin is not None:
-            self.process.stdin.close()  # the worker's loop ends
+            with contextlib.suppress(OSError):  # a dead worker's pipe cannot take the rest
+                self.process.stdin.close()  # the worker's loop ends
         try:
             self.process.wait(1)
         except subprocess.TimeoutExpired:
@@ -106,8 +108,11 @@ class _Pool:
 
     def _take(self) -> _Worker:
         with self.guard:
-            if self.idle:
-                return self.idle.pop()
+            while self.idle:
+                worker = self.idle.pop()
+                if worker.process.poll() is None:
+                    return worker
+                self.all.remove(worker)  # ended while idle (killed by hand, out of memory)
             worker = _Worker()
             self.all.append(worker)
             return worker
@@ -123,6 +128,14 @@ class _Pool:
         with self.guard:
             self.all.remove(worker)
         worker.stop()
+
+    def stop_idle(self) -> None:
+        with self.guard:
+            idle, self.idle = self.idle, []
+            for worker in idle:
+                self.all.remove(worker)
+        for worker in idle:
+            worker.stop()
 
     def stop(self) -> None:
         """Ends every worker; at exit, so that none outlives this process."""
@@ -140,11 +153,13 @@ _pool: _Pool | None = None
 
 def check_in_worker(document: object, budget: Budget) -> Report:
     """The engine's report on `document` within `budget`, from one of this process's workers;
-    a worker that died is replaced and the check tried once more."""
+    when the worker failed, the idle ones are replaced too and the check is tried once more."""
+    pool = _this_process_pool()
     try:
-        return _this_process_pool().check(document, budget)
+        return pool.check(document, budget)
     except EngineWorkerFailed:
-        return _this_process_pool().check(document, budget)
+        pool.stop_idle()  # what ended one (an OOM kill, a person's kill) may have ended them all
+        return pool.check(document, budget)
 
 
 def _this_process_pool() -> _Pool:

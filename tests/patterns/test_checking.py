@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -73,3 +74,18 @@ def alive(pid: int) -> bool:
     except FileNotFoundError:
         return False
     return stat.rsplit(")", 1)[1].split()[0] != "Z"  # a zombie waits only for its reaping
+
+
+def test_a_worker_outlives_the_request_thread_that_started_it() -> None:
+    # A server's request threads end; a worker tied to its thread (PR_SET_PDEATHSIG) died
+    # with the first request's, and every check after it failed.
+    document = factories.valid_document()
+    started = threading.Thread(target=checking.checked, args=(document, checking.publish_budget()))
+    started.start()
+    started.join()
+    before = worker_pids()
+
+    report = checking.checked(document, checking.publish_budget())
+
+    assert report["valid"] is True
+    assert set(before) <= set(worker_pids())
