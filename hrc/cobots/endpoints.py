@@ -128,21 +128,6 @@ def bind_host(host: str) -> str:
     return host
 
 
-def parse_networks(text: str) -> tuple[IPNetwork, ...]:
-    """Comma-separated CIDRs (`10.20.0.0/16, fd00::/8`); raises EndpointError naming a bad one."""
-    networks: list[IPNetwork] = []
-    for item in (part.strip() for part in text.split(",")):
-        if not item:
-            continue
-        try:
-            networks.append(ipaddress.ip_network(item, strict=False))
-        except ValueError:
-            raise EndpointError(
-                f"{item!r} is not a network in CIDR form (e.g. 10.0.0.0/8)."
-            ) from None
-    return tuple(networks)
-
-
 def resolve(host: str, port: int) -> list[IPAddress]:
     """Every address `host` stands for (itself for an IP literal); raises EndpointError when DNS fails."""
     address = parse_address(host)

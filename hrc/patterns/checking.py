@@ -36,7 +36,8 @@ from django.conf import settings
 from django.db import DatabaseError, connection
 
 from hrc.engine.budget import Budget
-from hrc.patterns.engine_workers import Report, check_in_worker
+from hrc.patterns.documents import Report
+from hrc.patterns.engine_workers import check_in_worker
 
 # High bits of every slot's advisory lock key, so the slots collide with no other
 # advisory lock: the key is this, the slot number and the organisation's id.

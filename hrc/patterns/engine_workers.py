@@ -23,13 +23,13 @@ import os
 import subprocess
 import sys
 import threading
-from typing import IO, Any
+from typing import IO
 
 from django.conf import settings
 
 from hrc.engine.budget import Budget
+from hrc.patterns.documents import Report
 
-Report = dict[str, Any]
 CHECKS_PER_WORKER = 50
 # Past its budget a check that has not answered is stuck: its worker is killed.
 OVERRUN_SECONDS = 30.0

@@ -3,6 +3,7 @@ the networks it may be on, and what a failed connection tells (issue 17, finding
 
 from __future__ import annotations
 
+import ipaddress
 import socket
 import threading
 from collections.abc import Iterator
@@ -20,7 +21,7 @@ from hrc.cobots import services
 from hrc.cobots.credentials import credentials_for
 from hrc.cobots.drivers.base import unreachable_message
 from hrc.cobots.drivers.runner import driver_for_cobot
-from hrc.cobots.endpoints import endpoint_key, parse_networks
+from hrc.cobots.endpoints import endpoint_key
 from hrc.cobots.gateway.launcher import free_port
 from hrc.cobots.models import Cobot, CredentialsSecret
 from hrc.cobots.selectors import live_state
@@ -213,7 +214,7 @@ def test_cobot_secret_sets_a_secret_from_the_environment(
 # --- HRC_COBOT_NETWORKS -------------------------------------------------------------------
 
 
-@override_settings(HRC_COBOT_NETWORKS=parse_networks("10.20.0.0/16"))
+@override_settings(HRC_COBOT_NETWORKS=[ipaddress.ip_network("10.20.0.0/16")])
 def test_an_endpoint_outside_the_networks_is_refused_at_registration(
     organisation: Organisation,
 ) -> None:
@@ -248,7 +249,7 @@ def test_the_driver_never_connects_outside_the_networks(
 ) -> None:
     port, accepted = listener
     cobot = factories.make_cobot(organisation, endpoint=f"opc.tcp://127.0.0.1:{port}")
-    with override_settings(HRC_COBOT_NETWORKS=parse_networks("10.20.0.0/16")):
+    with override_settings(HRC_COBOT_NETWORKS=[ipaddress.ip_network("10.20.0.0/16")]):
         state = live_state(cobot, timeout=1.0)
     assert state["reachable"] is False
     assert "HRC_COBOT_NETWORKS" in state["error"]

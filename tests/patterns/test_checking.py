@@ -6,9 +6,7 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
-from pathlib import Path
 
 from django.conf import settings
 
@@ -16,6 +14,7 @@ from hrc.engine.check import report_of
 from hrc.patterns import checking
 from hrc.patterns.engine_workers import worker_pids
 from tests import factories
+from tests.demo.rig import alive
 
 
 def test_a_check_runs_in_an_engine_worker_and_answers_as_the_engine_does() -> None:
@@ -48,6 +47,7 @@ django.setup()
 from hrc.patterns import checking
 from hrc.patterns.engine_workers import worker_pids
 from tests import factories
+from tests.demo.rig import alive
 checking.checked(factories.valid_document(), checking.interactive_budget())
 print(worker_pids()[0], flush=True)
 time.sleep(60)
@@ -66,26 +66,3 @@ def test_a_worker_dies_with_a_server_killed_outright() -> None:
     while alive(worker) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not alive(worker)
-
-
-def alive(pid: int) -> bool:
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except FileNotFoundError:
-        return False
-    return stat.rsplit(")", 1)[1].split()[0] != "Z"  # a zombie waits only for its reaping
-
-
-def test_a_worker_outlives_the_request_thread_that_started_it() -> None:
-    # A server's request threads end; a worker tied to its thread (PR_SET_PDEATHSIG) died
-    # with the first request's, and every check after it failed.
-    document = factories.valid_document()
-    started = threading.Thread(target=checking.checked, args=(document, checking.publish_budget()))
-    started.start()
-    started.join()
-    before = worker_pids()
-
-    report = checking.checked(document, checking.publish_budget())
-
-    assert report["valid"] is True
-    assert set(before) <= set(worker_pids())
