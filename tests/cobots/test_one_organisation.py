@@ -128,14 +128,17 @@ def test_the_django_admin_refuses_a_taken_gateway(
 def test_a_secret_is_stored_encrypted_and_read_back_for_its_own_organisation_only(
     organisation: Organisation, other_organisation: Organisation
 ) -> None:
-    services.set_credentials_secret(organisation, "gw", username="ours", password="p1", by=None)
+    # Not in the token's alphabet (base64url), so neither can turn up in it by chance, as
+    # "p1" once did.
+    user, password = "our user!", "pass word 1!"
+    services.set_credentials_secret(organisation, "gw", username=user, password=password, by=None)
     services.set_credentials_secret(
         other_organisation, "gw", username="theirs", password="p2", by=None
     )
     sealed = CredentialsSecret.objects.get(organisation=organisation).sealed
-    assert "p1" not in sealed
-    assert "ours" not in sealed
-    assert credentials_for("c", organisation.pk, "secret:gw") == ("ours", "p1")
+    assert password not in sealed
+    assert user not in sealed
+    assert credentials_for("c", organisation.pk, "secret:gw") == (user, password)
     assert credentials_for("c", other_organisation.pk, "secret:gw") == ("theirs", "p2")
 
 
