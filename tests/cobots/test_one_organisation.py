@@ -130,7 +130,7 @@ def test_a_secret_is_stored_encrypted_and_read_back_for_its_own_organisation_onl
 ) -> None:
     # Not in the token's alphabet (base64url), so neither can turn up in it by chance, as
     # "p1" once did.
-    user, password = "our user!", "pass word 1!"
+    user, password = "ours!", "pass word 1!"
     services.set_credentials_secret(organisation, "gw", username=user, password=password, by=None)
     services.set_credentials_secret(
         other_organisation, "gw", username="theirs", password="p2", by=None
