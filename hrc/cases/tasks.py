@@ -6,7 +6,7 @@ re-reads the rows and does nothing when there is nothing to do.
 
 from celery import shared_task
 
-from hrc.cases import jobs
+from hrc.cases import interruptions, jobs
 from hrc.cases.messages import purge_expired_messages
 
 
@@ -23,12 +23,12 @@ def sweep() -> dict[str, int]:
 
 @shared_task(ignore_result=True)
 def interrupt_cobot(interruption_id: int) -> None:
-    jobs.interrupt_cobot(interruption_id)
+    interruptions.interrupt_cobot(interruption_id)
 
 
 @shared_task(ignore_result=True)
 def resume_cobot(interruption_id: int) -> None:
-    jobs.resume_cobot(interruption_id)
+    interruptions.resume_cobot(interruption_id)
 
 
 @shared_task(ignore_result=True)

@@ -1,3 +1,5 @@
+from importlib import import_module
+
 from django.apps import AppConfig
 
 
@@ -6,8 +8,6 @@ class CobotsConfig(AppConfig):
     verbose_name = "Cobots"
 
     def ready(self) -> None:
-        from hrc.cobots import selectors
-        from hrc.organisations import hooks
-
-        # A cell cannot be deleted while a cobot stands in it.
-        hooks.register_cell_occupants(selectors.cobots_in_cell)
+        # receivers.py registers this app's answers to the inner apps' hooks. It imports
+        # models, which Django allows only once every app is loaded, that is, here.
+        import_module(f"{self.name}.receivers")

@@ -1,3 +1,5 @@
+from importlib import import_module
+
 from django.apps import AppConfig
 
 
@@ -6,8 +8,6 @@ class LiveConfig(AppConfig):
     verbose_name = "Live tablets"
 
     def ready(self) -> None:
-        from hrc.live import broadcast
-        from hrc.organisations import hooks
-
-        # An admin who ends a membership closes that person's sockets at once.
-        hooks.register_membership_ended(broadcast.membership_ended_on_commit)
+        # receivers.py registers this app's answers to the inner apps' hooks. It imports
+        # models, which Django allows only once every app is loaded, that is, here.
+        import_module(f"{self.name}.receivers")

@@ -1,3 +1,5 @@
+from importlib import import_module
+
 from django.apps import AppConfig
 
 
@@ -6,16 +8,6 @@ class OrganisationsConfig(AppConfig):
     verbose_name = "Organisations and people"
 
     def ready(self) -> None:
-        from django.contrib.auth import get_user_model
-        from django.db.models.signals import post_save
-
-        from hrc.organisations import services
-
-        # A password is changed by the admin's forms, `changepassword`, the reset pages
-        # and these services alike, all through set_password() and save(): the save is the
-        # one place that sees every change, so the user's API keys go there.
-        post_save.connect(
-            services.revoke_api_tokens_on_new_password,
-            sender=get_user_model(),
-            dispatch_uid="hrc-revoke-api-tokens-on-new-password",
-        )
+        # receivers.py registers this app's answers to the inner apps' hooks. It imports
+        # models, which Django allows only once every app is loaded, that is, here.
+        import_module(f"{self.name}.receivers")

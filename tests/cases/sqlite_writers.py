@@ -18,7 +18,7 @@ django.setup()
 
 from django.db import connection, connections, transaction  # noqa: E402
 
-from hrc.cases import jobs, services  # noqa: E402
+from hrc.cases import interruptions, services  # noqa: E402
 from hrc.cases.choices import InterruptionMode  # noqa: E402
 from hrc.cases.models import Case, CaseEvent, Interruption, Job, Message  # noqa: E402
 from hrc.cobots.models import Cobot  # noqa: E402
@@ -137,7 +137,7 @@ def pause_a_silent_cobot(case: Case, operator: Any) -> dict[str, Any]:
 
     def pause() -> None:
         try:
-            jobs.interrupt_cobot(interruption.pk)
+            interruptions.interrupt_cobot(interruption.pk)
         finally:
             connections.close_all()
 

@@ -1,0 +1,7 @@
+"""The live app's answers to the inner apps' hooks, registered when Django is ready (apps.py)."""
+
+from hrc.live import broadcast
+from hrc.organisations import hooks as organisation_hooks
+
+# An admin who ends a membership closes that person's sockets at once.
+organisation_hooks.register_membership_ended(broadcast.membership_ended_on_commit)
