@@ -1,9 +1,10 @@
-"""Every command in the README's code blocks works as written on a fresh clone.
+"""Every command in the README's and the docs' code blocks works as written on a fresh clone.
 
-The commands are read from the fenced blocks of README.md and docker/README.md (comments
-after `#` dropped, `\\` continuations joined). Each must be named below, either with how
-this test runs it or with why it cannot run here, so a README command added without a
-test fails `test_every_readme_command_is_run_or_has_a_reason`. They run on the embedded
+The commands are read from the fenced command blocks (no language, or bash/sh/shell/console)
+of README.md, docker/README.md and docs/*.md (comments after `#` dropped, `\\` continuations
+joined); blocks marked text, json or python are not commands. Each must be named below,
+either with how this test runs it or with why it cannot run here, so a command added without
+a test fails `test_every_readme_command_is_run_or_has_a_reason`. They run on the embedded
 default (no DATABASE_URL, no REDIS_URL) with the clone's files under a scratch
 HRC_VAR_DIR, HRC_PKI_DIR and HRC_SIM_STATE_DIR. Changes to a command as written: a free
 port instead of 4841 (tests run side by side), and the placeholder my-pattern.json is an
@@ -27,7 +28,9 @@ import pytest
 from hrc.cobots.gateway.launcher import free_port
 from tests.cases.test_run_pattern_embedded import ROOT, embedded_environment
 
-FENCE = re.compile(r"^```[^\n]*\n(.*?)^```", re.MULTILINE | re.DOTALL)
+FENCE = re.compile(r"^```([^\n]*)\n(.*?)^```", re.MULTILINE | re.DOTALL)
+# The info strings of a block of commands; any other language is an example, not a command.
+COMMAND_BLOCKS = frozenset({"", "bash", "sh", "shell", "console"})
 
 # The commands this module cannot run, and why.
 CANNOT_RUN = {
@@ -80,7 +83,9 @@ RUN_HERE = {
 def readme_commands(path: Path) -> list[str]:
     """The commands of a Markdown file's fenced blocks, one per line, without comments."""
     commands = []
-    for block in FENCE.findall(path.read_text()):
+    for language, block in FENCE.findall(path.read_text()):
+        if language.strip() not in COMMAND_BLOCKS:
+            continue
         for line in block.replace("\\\n", " ").splitlines():
             command = " ".join(re.sub(r"\s#.*$", "", line).split())
             if command and not command.startswith("#"):
@@ -88,8 +93,17 @@ def readme_commands(path: Path) -> list[str]:
     return commands
 
 
+def documented_files() -> list[Path]:
+    """The Markdown files whose commands a reader runs: the READMEs and the docs' pages."""
+    return [
+        ROOT / "README.md",
+        ROOT / "docker" / "README.md",
+        *sorted((ROOT / "docs").glob("*.md")),
+    ]
+
+
 def all_commands() -> list[str]:
-    return readme_commands(ROOT / "README.md") + readme_commands(ROOT / "docker" / "README.md")
+    return [command for path in documented_files() for command in readme_commands(path)]
 
 
 def test_every_readme_command_is_run_or_has_a_reason() -> None:
@@ -107,6 +121,20 @@ def test_the_fence_parser_reads_commands_and_drops_comments(tmp_path: Path) -> N
     )
 
     assert readme_commands(readme) == ["make a", "run --x 1"]
+
+
+def test_only_command_blocks_hold_commands(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text("```bash\nmake a\n```\n\n```text\nnot/a/command\n```\n\n```json\n{}\n```\n")
+
+    assert readme_commands(page) == ["make a"]
+
+
+def test_the_docs_pages_are_read_for_commands() -> None:
+    assert ROOT / "docs" / "admins.md" in documented_files()
+    assert ".venv/bin/python manage.py cobot_call cobot1 PowerOn" in readme_commands(
+        ROOT / "docs" / "admins.md"
+    )
 
 
 class Clone:
