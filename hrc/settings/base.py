@@ -103,7 +103,7 @@ if DATABASE_URL:
     if DATABASES["default"]["ENGINE"] == "django.db.backends.postgresql":
         # A pool per process, not persistent connections: under ASGI each request runs
         # on a thread of its own, whose connection would be a new PostgreSQL session
-        # per request (~3 ms of two processes' CPU). With the health checks on, the
+        # per request (its cost: bench/README.md). With the health checks on, the
         # pool checks a connection as it is taken: one that a database restart broke
         # is replaced, not handed out.
         options = DATABASES["default"].setdefault("OPTIONS", {})
