@@ -7,6 +7,7 @@ warning; --strict makes any warning fail the build, so a renamed heading fails h
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 from pathlib import Path
 
@@ -44,3 +45,12 @@ def test_a_broken_link_fails_the_build(tmp_path: Path) -> None:
 
     assert built.returncode != 0
     assert "no-such-page.md" in built.stderr
+
+
+def test_the_readme_is_short_and_links_only_to_pages_that_exist() -> None:
+    readme = (ROOT / "README.md").read_text()
+    links = re.findall(r"\]\((docs/[^)#]+)", readme)
+
+    assert len(readme.splitlines()) < 120
+    assert links, "the README links into docs/"
+    assert [link for link in links if not (ROOT / link).is_file()] == []
