@@ -3,7 +3,8 @@
 // and shows the result or the refusal; the state is refreshed every few seconds, the record
 // and the registers after each command.
 
-import { getJson, postJson, problemOf, type PageJson } from "../supervisor/api";
+import { getJson, postJson, problemOf } from "../shared/http";
+import type { PageJson } from "../supervisor/api";
 import {
   commandBody,
   commandRow,
@@ -24,7 +25,6 @@ interface PageConfig {
 }
 
 const config = JSON.parse(document.getElementById("cobot-page")?.textContent ?? "{}") as PageConfig;
-const csrfToken = document.querySelector<HTMLMetaElement>('meta[name="csrf-token"]')?.content ?? "";
 const dialog = document.getElementById("confirm") as HTMLDialogElement;
 const outcome = document.getElementById("outcome") as HTMLElement;
 const problem = document.getElementById("problem") as HTMLElement;
@@ -53,7 +53,7 @@ async function run(button: HTMLButtonElement): Promise<void> {
   button.disabled = true;
   try {
     const url = `${config.api.base}${button.dataset.path}/`;
-    const record = await postJson<CommandJson>(url, commandBody(command, program), csrfToken);
+    const record = await postJson<CommandJson>(url, commandBody(command, program));
     tell(doneText(record, config.name), "");
   } catch (error) {
     tell("", problemOf(error));

@@ -11,15 +11,8 @@
 import type { LiveEvent } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { LiveStore } from "../live/store";
-import {
-  getJson,
-  postJson,
-  problemOf,
-  type CaseJson,
-  type EventJson,
-  type IncidentJson,
-  type PageJson,
-} from "./api";
+import { getJson, postJson, problemOf } from "../shared/http";
+import type { CaseJson, EventJson, IncidentJson, PageJson } from "./api";
 import {
   concernsCase,
   concernsIncidents,
@@ -68,10 +61,6 @@ interface IncidentsPageConfig {
 }
 
 type PageConfig = CasePageConfig | IncidentsPageConfig;
-
-function csrfToken(): string {
-  return document.querySelector<HTMLMetaElement>('meta[name="csrf-token"]')?.content ?? "";
-}
 
 const STATUS_TEXT: Record<ConnectionStatus, string> = {
   connecting: "connecting…",
@@ -174,7 +163,7 @@ async function resolve(
   buttons.forEach((button) => (button.disabled = true));
   try {
     const url = resolveUrl.replace(/\/0\/resolve\/$/, `/${card.dataset.incident}/resolve/`);
-    const incident = await postJson<IncidentJson>(url, body.value, csrfToken());
+    const incident = await postJson<IncidentJson>(url, body.value);
     applyIncident(card, incident);
     return incident;
   } catch (error) {
@@ -246,7 +235,7 @@ function onReassign(workItemsUrl: string, after: () => Promise<void>): void {
     event.preventDefault();
     handOver.disabled = true;
     const user = select.value ? Number(select.value) : null;
-    postJson(`${workItemsUrl}${item}/reassign/`, { user }, csrfToken())
+    postJson(`${workItemsUrl}${item}/reassign/`, { user })
       .then(() => {
         dialog.close();
         void after();

@@ -4,7 +4,7 @@ import "./tablet.css";
 import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
-import { ApiError, request } from "./api";
+import { ApiError, problemOf, request } from "../shared/http";
 import { buildForm, type FormSchema } from "./form";
 import {
   activity,
@@ -239,7 +239,7 @@ async function act(button: HTMLButtonElement, url: string, body?: unknown): Prom
     await request("POST", url, body ?? {});
     return true;
   } catch (error) {
-    flash(error instanceof ApiError ? error.message : String(error));
+    flash(problemOf(error));
     return false;
   } finally {
     button.disabled = false;
@@ -252,7 +252,7 @@ async function openForm(id: number): Promise<void> {
   try {
     detail = await request("GET", `/api/work-items/${id}/`);
   } catch (error) {
-    flash(error instanceof ApiError ? error.message : String(error));
+    flash(problemOf(error));
     return;
   }
   const form = element("form", "task-form");
@@ -287,7 +287,7 @@ async function openForm(id: number): Promise<void> {
         const rest = answers.showErrors(failure.fields);
         error.textContent = rest.length ? rest.join(" ") : "Correct the answers marked above.";
       } else {
-        error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+        error.textContent = problemOf(failure);
       }
     } finally {
       submit.disabled = false;
