@@ -11,6 +11,7 @@
 import type { LiveEvent } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { LiveStore } from "../live/store";
+import { pageConfig } from "../shared/dom";
 import { getJson, postJson, problemOf } from "../shared/http";
 import type { CaseJson, EventJson, IncidentJson, PageJson } from "./api";
 import {
@@ -352,9 +353,8 @@ function startIncidentsPage(config: IncidentsPageConfig): void {
 }
 
 function start(): void {
-  const source = document.getElementById("supervisor-page");
-  if (!source?.textContent) return;
-  const config = JSON.parse(source.textContent) as PageConfig;
+  const config = pageConfig<PageConfig>("supervisor-page");
+  if (!config) return;
   if (config.page === "case") startCasePage(config);
   else startIncidentsPage(config);
 }

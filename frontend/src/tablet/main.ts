@@ -4,6 +4,7 @@ import "./tablet.css";
 import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
+import { element, pageConfig } from "../shared/dom";
 import { ApiError, problemOf, request } from "../shared/http";
 import { buildForm, type FormSchema } from "./form";
 import {
@@ -39,7 +40,7 @@ const STATUS_TEXT: Record<ConnectionStatus, string> = {
 const MAX_MESSAGES = 20;
 
 const root = document.getElementById("tablet") as HTMLElement;
-const config = JSON.parse(document.getElementById("tablet-config")!.textContent!) as Config;
+const config = pageConfig<Config>("tablet-config")!;
 const $ = <T extends HTMLElement>(selector: string): T => root.querySelector(selector) as T;
 
 const store = new LiveStore();
@@ -320,13 +321,6 @@ function flash(text: string): void {
   note.setAttribute("role", "alert");
   connection.after(note);
   setTimeout(() => note.remove(), 6000);
-}
-
-function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = "", text?: string): HTMLElementTagNameMap[K] {
-  const node = document.createElement(tag);
-  if (className) node.className = className;
-  if (text !== undefined) node.textContent = text;
-  return node;
 }
 
 // For the browser tests and a curious engineer's console.

@@ -17,7 +17,8 @@ import { quotedName } from "../../model/words";
 import { isLane, lanesTopDown, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
-import { add, button, field, heading, note, select } from "./fields";
+import { addElement } from "../../../shared/dom";
+import { button, field, heading, note, select } from "./fields";
 import { taskSection } from "./TaskSection";
 
 type Element = Shape | Connection;
@@ -37,7 +38,7 @@ export default class PropertiesPanel {
     private readonly elementFactory: PatternElementFactory,
     private readonly deviceCalls: Record<string, string[]>,
   ) {
-    this.panel = add(shell.side, "section", "hrc-properties");
+    this.panel = addElement(shell.side, "section", "hrc-properties");
     this.panel.setAttribute("aria-label", "Properties");
     eventBus.on(["selection.changed", "import.done", "commandStack.changed"], () => this.render());
   }
