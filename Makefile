@@ -52,6 +52,7 @@ lint: install  ## ruff, mypy and tsc
 	.venv/bin/ruff format --check .
 	.venv/bin/mypy hrc tests bench
 	cd frontend && npx tsc --noEmit
+	cd frontend && npx eslint .
 
 $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
 	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true

@@ -119,7 +119,7 @@ export class LiveStore {
     const next = known === null ? 1 : known + 1;
     if (delta.seq !== next || (known === null && delta.type !== "case")) {
       let waiting = this.held.get(delta.case);
-      if (!waiting) this.held.set(delta.case, (waiting = new Map()));
+      if (!waiting) this.held.set(delta.case, (waiting = new Map<number, CaseStreamDelta>()));
       waiting.set(delta.seq, delta);
       return "held";
     }

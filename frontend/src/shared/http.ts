@@ -110,7 +110,7 @@ function fieldsOf(body: Record<string, unknown>): FieldErrors {
   const fields: FieldErrors = {};
   for (const [field, messages] of Object.entries(source)) {
     if (typeof messages === "string" || (Array.isArray(messages) && messages.every((m) => typeof m === "string"))) {
-      fields[field] = messages as string | string[];
+      fields[field] = messages;
     }
   }
   return fields;

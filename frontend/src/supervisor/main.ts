@@ -232,7 +232,7 @@ function onReassign(workItemsUrl: string, after: () => Promise<void>): void {
   });
 
   form.addEventListener("submit", (event) => {
-    if ((event as SubmitEvent).submitter !== handOver) return; // Cancel closes the dialog
+    if (event.submitter !== handOver) return; // Cancel closes the dialog
     event.preventDefault();
     handOver.disabled = true;
     const user = select.value ? Number(select.value) : null;

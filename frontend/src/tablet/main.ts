@@ -226,7 +226,7 @@ function renderMessages(): void {
 // Actions -----------------------------------------------------------------------------------
 
 root.addEventListener("click", (event) => {
-  const button = (event.target as HTMLElement).closest("button[data-action]") as HTMLButtonElement | null;
+  const button = (event.target as HTMLElement).closest<HTMLButtonElement>("button[data-action]");
   if (!button) return;
   const id = Number(button.dataset.item);
   const action = button.dataset.action!;
@@ -271,8 +271,7 @@ async function openForm(id: number): Promise<void> {
   const actions = element("div", "actions");
   actions.append(cancel, submit);
   form.append(element("h2", "", detail.label), element("p", "instructions", detail.instructions), fields, error, actions);
-  form.addEventListener("submit", async (event) => {
-    event.preventDefault();
+  const complete = async (): Promise<void> => {
     error.textContent = "";
     // Required answers are asked for here, at their fields; the server refuses them too.
     if (!answers.check()) {
@@ -293,6 +292,10 @@ async function openForm(id: number): Promise<void> {
     } finally {
       submit.disabled = false;
     }
+  };
+  form.addEventListener("submit", (event) => {
+    event.preventDefault();
+    void complete();
   });
   dialog.replaceChildren(form);
   dialog.showModal();

@@ -83,7 +83,7 @@ export function parsePoses(text: string): unknown {
     try {
       return parsePose(line);
     } catch (error) {
-      throw new Error(`Pose ${index + 1}: ${(error as Error).message}`);
+      throw new Error(`Pose ${index + 1}: ${(error as Error).message}`, { cause: error });
     }
   });
 }

@@ -47,7 +47,7 @@ export default class PropertiesPanel {
     const selected = this.selection.get() as Element[];
     this.panel.replaceChildren();
     const element = selected.length === 1 ? selected[0] : null;
-    const object = objectOf(element) as PatternObject | undefined;
+    const object = objectOf(element);
     if (selected.length > 1) {
       note(this.panel, `${selected.length} elements selected.`);
       return;
