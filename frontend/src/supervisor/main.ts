@@ -13,6 +13,7 @@ import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { LiveStore } from "../live/store";
 import { pageConfig } from "../shared/dom";
 import { getJson, postJson, problemOf } from "../shared/http";
+import type { Resolution } from "../shared/choices";
 import type { CaseJson, EventJson, IncidentJson, PageJson } from "./api";
 import {
   concernsCase,
@@ -26,7 +27,6 @@ import {
   touchesInterruptions,
   unseenEvents,
   workRow,
-  type Resolution,
 } from "./model";
 import {
   applyIncident,

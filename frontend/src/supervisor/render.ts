@@ -1,11 +1,10 @@
 // The page's DOM, kept the shape the server renders it in (templates/cases/): the net's
 // tokens and task states, incident cards, the open tasks, timeline rows.
 
+import { CASE_STATUSES, INCIDENT_KINDS } from "../shared/choices";
 import { element } from "../shared/dom";
 import type { IncidentJson, Marking } from "./api";
 import {
-  CASE_STATUSES,
-  INCIDENT_KINDS,
   constraintTokens,
   formatTime,
   outcomeText,
