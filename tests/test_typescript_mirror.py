@@ -58,6 +58,7 @@ MIRRORS: list[tuple[str, str, Callable[[typing.Any], object], object]] = [
     ("editor/model/taskconfig.ts", "TaskKind", set, set(typing.get_args(taskconfig.TaskKind))),
     ("editor/model/taskconfig.ts", "POSE_LENGTH", int, taskconfig.POSE_LENGTH),
     ("editor/model/taskconfig.ts", "MAX_POSES", int, taskconfig.MAX_POSES),
+    ("editor/model/taskconfig.ts", "INTERRUPT_MODES", list, list(taskconfig.INTERRUPT_MODES)),
     (
         "editor/model/taskconfig.ts",
         "DEVICE_CALLS",
@@ -81,7 +82,7 @@ def read_literal(text: str, name: str) -> object:
     literal = found.group(1).strip()
     literal = re.sub(r"^new Set\((.*)\)$", r"\1", literal, flags=re.S)
     literal = re.sub(r"\s+as const$", "", literal)
-    literal = re.sub(r"^(\s*)([A-Za-z_]\w*):", r'\1"\2":', literal, flags=re.M)  # bare keys
+    literal = re.sub(r"([{,]\s*)([A-Za-z_]\w*):", r'\1"\2":', literal)  # bare keys
     literal = re.sub(r",(\s*[}\]])", r"\1", literal)  # trailing commas
     return json.loads(literal)
 
@@ -97,6 +98,15 @@ def test_the_typescript_copy_says_what_python_says(
     assert _read(path, name, kind) == python
 
 
+def _sample(python: object) -> str:
+    """A value of the Python constant, as the TypeScript copy spells it."""
+    if isinstance(python, dict):
+        return str(next(iter(python)))
+    if isinstance(python, set | list):
+        return str(min(python) if isinstance(python, set) else python[0])
+    return str(python)
+
+
 @pytest.mark.parametrize(("path", "name", "kind", "python"), MIRRORS, ids=lambda v: str(v)[:40])
 def test_a_changed_value_in_the_copy_is_seen(
     path: str, name: str, kind: Callable[[typing.Any], object], python: object
@@ -104,9 +114,7 @@ def test_a_changed_value_in_the_copy_is_seen(
     text = (FRONTEND / path).read_text()
     start = re.search(rf"^export (?:const|type) {name}\b", text, re.M)
     assert start
-    # Change the first value after the name (a string's first letter, or a number's digit).
-    value = re.compile(r'"(\w)|= (\d)').search(text, start.end())
-    assert value
-    at = value.start(1) if value.group(1) else value.start(2)
-    changed = text[:at] + ("X" if value.group(1) else "9") + text[at + 1 :]
+    sample = _sample(python)
+    at = text.index(sample, start.end())
+    changed = text[:at] + ("9" if sample.isdigit() else "X") + text[at + 1 :]
     assert kind(read_literal(changed, name)) != python

@@ -10,6 +10,7 @@ import type Selection from "diagram-js/lib/features/selection/Selection";
 import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
 import { PATTERN_NAMES } from "../../model/document";
+import { INTERRUPT_MODES } from "../../model/taskconfig";
 import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
@@ -139,7 +140,7 @@ export default class PropertiesPanel {
     reverse.title = "Swap the two tasks: the constraint then runs the other way";
     select(this.panel, "Kind", object.data.type, CONSTRAINT_TYPES.map((type): [string, string] => [type, type]), (type) => this.modeling.updateData(connection, { type, interrupt: type === "space" ? object.data.interrupt : undefined }));
     if (object.data.type === "space") {
-      select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), [["pause", "pauses"], ["slow", "slows down"]], (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));
+      select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), Object.entries(INTERRUPT_MODES), (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));
     }
   }
 
