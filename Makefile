@@ -47,11 +47,12 @@ test: install $(BENCH_STAMP) $(CHROMIUM)  ## run the whole test suite (PostgreSQ
 	@if [ -d frontend/test ]; then cd frontend && npx vitest run; fi
 	$(PY) -m pytest -n 2 -p no:cacheprovider
 
-lint: install  ## ruff, mypy and tsc
+lint: install  ## ruff, mypy, tsc, ESLint, the import contracts, the docs build
 	.venv/bin/ruff check .
 	.venv/bin/ruff format --check .
 	.venv/bin/mypy hrc tests bench
 	cd frontend && npx tsc --noEmit
+	cd frontend && npx eslint .
 	NO_MKDOCS_2_WARNING=1 .venv/bin/mkdocs build --strict --quiet  # docs/ into site/ (ignored)
 
 $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt

@@ -1,6 +1,7 @@
 import { describe, expect, it } from "vitest";
 
-import { Refusal, problemOf, refusalMessage, type EventJson, type IncidentJson, type WorkItemJson } from "../src/supervisor/api";
+import { ApiError, problemOf, refusalMessage } from "../src/shared/http";
+import type { EventJson, IncidentJson, WorkItemJson } from "../src/supervisor/api";
 import type { LiveEvent } from "../src/live/events";
 import {
   POLL_MS,
@@ -218,8 +219,8 @@ describe("resolving an incident", () => {
     );
     expect(refusalMessage(502, null)).toBe("The server answered 502.");
     expect(refusalMessage(0, null)).toBe("The server cannot be reached.");
-    expect(new Refusal(403, "no").status).toBe(403);
-    expect(problemOf(new Refusal(409, "count parts has started: name who finishes it."))).toBe(
+    expect(new ApiError(403, "no").status).toBe(403);
+    expect(problemOf(new ApiError(409, "count parts has started: name who finishes it."))).toBe(
       "count parts has started: name who finishes it.",
     );
     expect(problemOf(new TypeError("bad"))).toBe("TypeError: bad");

@@ -41,7 +41,7 @@ def incident(step_case: Case) -> Incident:
 
 
 PAGES = ["/cases/", "/incidents/"]
-SCRIPT = Path(settings.BASE_DIR) / "frontend" / "src" / "supervisor"
+SCRIPT = Path(settings.BASE_DIR) / "frontend" / "src" / "shared"
 
 
 # Who may look ------------------------------------------------------------------------------
@@ -339,12 +339,12 @@ def test_the_incidents_page_lists_open_incidents_with_their_case(
 
 @pytest.mark.parametrize(
     ("table", "choices"),
-    [("EVENT_NAMES", EventType), ("INCIDENT_KINDS", IncidentKind), ("CASE_STATUSES", CaseStatus)],
+    [("EVENT_TYPES", EventType), ("INCIDENT_KINDS", IncidentKind), ("CASE_STATUSES", CaseStatus)],
 )
 def test_the_page_script_names_things_as_the_server_does(
     table: str, choices: type[TextChoices]
 ) -> None:
-    source = (SCRIPT / "model.ts").read_text()
+    source = (SCRIPT / "choices.ts").read_text()
     body = re.search(rf"export const {table}: Record<string, string> = {{(.*?)}};", source, re.S)
     assert body, table
     pairs = re.findall(r'"?([a-z-]+)"?: "([^"]+)"', body.group(1))

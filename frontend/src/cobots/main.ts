@@ -3,7 +3,9 @@
 // and shows the result or the refusal; the state is refreshed every few seconds, the record
 // and the registers after each command.
 
-import { getJson, postJson, problemOf, type PageJson } from "../supervisor/api";
+import { element, pageConfig } from "../shared/dom";
+import { getJson, postJson, problemOf } from "../shared/http";
+import type { PageJson } from "../supervisor/api";
 import {
   commandBody,
   commandRow,
@@ -23,8 +25,7 @@ interface PageConfig {
   api: { base: string; state: string; registers: string; commands: string };
 }
 
-const config = JSON.parse(document.getElementById("cobot-page")?.textContent ?? "{}") as PageConfig;
-const csrfToken = document.querySelector<HTMLMetaElement>('meta[name="csrf-token"]')?.content ?? "";
+const config = pageConfig<PageConfig>("cobot-page")!;
 const dialog = document.getElementById("confirm") as HTMLDialogElement;
 const outcome = document.getElementById("outcome") as HTMLElement;
 const problem = document.getElementById("problem") as HTMLElement;
@@ -53,7 +54,7 @@ async function run(button: HTMLButtonElement): Promise<void> {
   button.disabled = true;
   try {
     const url = `${config.api.base}${button.dataset.path}/`;
-    const record = await postJson<CommandJson>(url, commandBody(command, program), csrfToken);
+    const record = await postJson<CommandJson>(url, commandBody(command, program));
     tell(doneText(record, config.name), "");
   } catch (error) {
     tell("", problemOf(error));
@@ -92,16 +93,9 @@ async function refreshCommands(): Promise<void> {
   if (!body || new URLSearchParams(location.search).has("page")) return; // an older page stays
   body.replaceChildren(
     ...page.results.map((record) => {
-      const row = document.createElement("tr");
-      row.dataset.commandId = String(record.id);
-      commandRow(record).forEach((text, index) => {
-        const cell = document.createElement("td");
-        cell.textContent = text;
-        if (index === 3) cell.className = `outcome-${record.outcome}`;
-        if (index === 4) cell.className = "detail";
-        row.append(cell);
-      });
-      return row;
+      const classes = ["", "", "", `outcome-${record.outcome}`, "detail"];
+      const cells = commandRow(record).map((text, index) => element("td", classes[index] ?? "", text));
+      return element("tr", { "data-command-id": String(record.id) }, ...cells);
     }),
   );
 }

@@ -1,5 +1,7 @@
 // What the cobot page shows, as pure functions of the API's answers (hrc/cobots/api/).
 
+import { COMMAND_OUTCOMES, CONTROL_COMMANDS } from "../shared/choices";
+
 /** A control command as the record shows it (hrc.cobots.api.serializers.CobotCommandSerializer). */
 export interface CommandJson {
   id: number;
@@ -29,23 +31,6 @@ export interface RegistersJson {
   outputs: Record<string, unknown>;
 }
 
-// The names hrc.cobots.choices.ControlCommand and CommandOutcome give.
-const COMMAND_NAMES: Record<string, string> = {
-  "power-on": "Power on",
-  "brake-release": "Release the brakes",
-  "power-off": "Power off",
-  "load-program": "Load a program",
-  "start-program": "Start the program",
-  "pause-program": "Pause the program",
-  "stop-program": "Stop the program",
-};
-const OUTCOME_NAMES: Record<string, string> = {
-  running: "Running",
-  ok: "Done",
-  refused: "Refused",
-  failed: "Failed",
-};
-
 /** The request body of a command: always confirmed (the dialog asked), a load names its program. */
 export function commandBody(command: string, program: string): Record<string, unknown> {
   return command === "load-program" ? { program, confirm: true } : { confirm: true };
@@ -64,12 +49,12 @@ const QUESTIONS: Record<string, string> = {
 /** The dialog's question: "Power on cobot1?", "Load Pick on cobot1?". */
 export function question(command: string, cobot: string, program: string): string {
   if (command === "load-program") return `Load ${program || "(no program)"} on ${cobot}?`;
-  return `${QUESTIONS[command] ?? COMMAND_NAMES[command] ?? command} ${cobot}?`;
+  return `${QUESTIONS[command] ?? CONTROL_COMMANDS[command] ?? command} ${cobot}?`;
 }
 
 /** What the page says once the cobot has done a command. */
 export function doneText(record: CommandJson, cobot: string): string {
-  return `${COMMAND_NAMES[record.command] ?? record.command}: ${cobot} done.`;
+  return `${CONTROL_COMMANDS[record.command] ?? record.command}: ${cobot} done.`;
 }
 
 /** The cells of a row of the record: when, who, what, outcome, message. */
@@ -78,8 +63,8 @@ export function commandRow(record: CommandJson): string[] {
   return [
     formatTime(record.requested_at),
     record.requested_by ?? "–",
-    `${COMMAND_NAMES[record.command] ?? record.command}${program}`,
-    OUTCOME_NAMES[record.outcome] ?? record.outcome,
+    `${CONTROL_COMMANDS[record.command] ?? record.command}${program}`,
+    COMMAND_OUTCOMES[record.outcome] ?? record.outcome,
     record.message,
   ];
 }

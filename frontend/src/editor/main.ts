@@ -6,6 +6,7 @@
 import "diagram-js/assets/diagram-js.css";
 import "./editor.css";
 
+import { addElement, pageConfig } from "../shared/dom";
 import { Api } from "./api";
 import { PatternEditor } from "./editor";
 import { emptyDocument, readDocument, DocumentError } from "./model/document";
@@ -21,14 +22,14 @@ export interface PageConfig {
 
 export async function mount(root: HTMLElement, config: PageConfig): Promise<PatternEditor> {
   root.classList.add("hrc-editor");
-  const toolbar = part(root, "div", "hrc-toolbar");
+  const toolbar = addElement(root, "div", "hrc-toolbar");
   toolbar.setAttribute("role", "toolbar");
   toolbar.setAttribute("aria-label", "Pattern");
-  const body = part(root, "div", "hrc-body");
-  const canvas = part(body, "div", "hrc-canvas");
-  const side = part(body, "aside", "hrc-side");
+  const body = addElement(root, "div", "hrc-body");
+  const canvas = addElement(body, "div", "hrc-canvas");
+  const side = addElement(body, "aside", "hrc-side");
   const editor = new PatternEditor({ canvas, toolbar, side, api: new Api(config.api ?? "/api"), pattern: config.pattern, liveChecking: config.liveChecking, deviceCalls: config.deviceCalls });
-  const notice = part(root, "p", "hrc-notice");
+  const notice = addElement(root, "p", "hrc-notice");
   notice.setAttribute("role", "alert");
   try {
     const document = config.draft === undefined || config.draft === null ? emptyDocument(config.pattern.name) : readDocument(config.draft);
@@ -42,17 +43,9 @@ export async function mount(root: HTMLElement, config: PageConfig): Promise<Patt
   return editor;
 }
 
-function part(parent: HTMLElement, tag: string, className: string): HTMLElement {
-  const element = document.createElement(tag);
-  element.className = className;
-  parent.appendChild(element);
-  return element;
-}
-
 const root = document.getElementById("hrc-editor");
-const configElement = document.getElementById("hrc-editor-config");
-if (root && configElement) {
-  const config = JSON.parse(configElement.textContent ?? "{}") as PageConfig;
+const config = pageConfig<PageConfig>("hrc-editor-config");
+if (root && config) {
   void mount(root, config).then((editor) => {
     // The browser tests and the bench reach the editor through the page.
     (window as unknown as { hrcEditor: PatternEditor }).hrcEditor = editor;

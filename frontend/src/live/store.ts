@@ -21,9 +21,8 @@ import type {
   UserData,
   WorkItemData,
 } from "./events";
+import { OPEN_CASE_STATUSES, OPEN_WORK_ITEM_STATES } from "../shared/choices";
 
-export const OPEN_CASE_STATUSES: ReadonlySet<string> = new Set(["running", "suspended"]);
-export const OPEN_ITEM_STATES: ReadonlySet<string> = new Set(["offered", "claimed", "running"]);
 
 export interface LiveState {
   organisation: number;
@@ -119,7 +118,7 @@ export class LiveStore {
     const next = known === null ? 1 : known + 1;
     if (delta.seq !== next || (known === null && delta.type !== "case")) {
       let waiting = this.held.get(delta.case);
-      if (!waiting) this.held.set(delta.case, (waiting = new Map()));
+      if (!waiting) this.held.set(delta.case, (waiting = new Map<number, CaseStreamDelta>()));
       waiting.set(delta.seq, delta);
       return "held";
     }
@@ -152,7 +151,7 @@ export class LiveStore {
     if (current) current.seq = delta.seq;
     else if (this.ended.has(delta.case)) this.ended.set(delta.case, delta.seq);
     if (delta.type === "work-item") {
-      if (OPEN_ITEM_STATES.has(delta.item.state)) state.workItems.set(delta.item.id, delta.item);
+      if (OPEN_WORK_ITEM_STATES.has(delta.item.state)) state.workItems.set(delta.item.id, delta.item);
       else state.workItems.delete(delta.item.id);
     } else if (delta.incident.resolution === "") {
       state.incidents.set(delta.incident.id, delta.incident);

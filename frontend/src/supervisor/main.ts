@@ -11,15 +11,10 @@
 import type { LiveEvent } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { LiveStore } from "../live/store";
-import {
-  getJson,
-  postJson,
-  problemOf,
-  type CaseJson,
-  type EventJson,
-  type IncidentJson,
-  type PageJson,
-} from "./api";
+import { pageConfig } from "../shared/dom";
+import { getJson, postJson, problemOf } from "../shared/http";
+import type { Resolution } from "../shared/choices";
+import type { CaseJson, EventJson, IncidentJson, PageJson } from "./api";
 import {
   concernsCase,
   concernsIncidents,
@@ -32,7 +27,6 @@ import {
   touchesInterruptions,
   unseenEvents,
   workRow,
-  type Resolution,
 } from "./model";
 import {
   applyIncident,
@@ -68,10 +62,6 @@ interface IncidentsPageConfig {
 }
 
 type PageConfig = CasePageConfig | IncidentsPageConfig;
-
-function csrfToken(): string {
-  return document.querySelector<HTMLMetaElement>('meta[name="csrf-token"]')?.content ?? "";
-}
 
 const STATUS_TEXT: Record<ConnectionStatus, string> = {
   connecting: "connecting…",
@@ -174,7 +164,7 @@ async function resolve(
   buttons.forEach((button) => (button.disabled = true));
   try {
     const url = resolveUrl.replace(/\/0\/resolve\/$/, `/${card.dataset.incident}/resolve/`);
-    const incident = await postJson<IncidentJson>(url, body.value, csrfToken());
+    const incident = await postJson<IncidentJson>(url, body.value);
     applyIncident(card, incident);
     return incident;
   } catch (error) {
@@ -242,11 +232,11 @@ function onReassign(workItemsUrl: string, after: () => Promise<void>): void {
   });
 
   form.addEventListener("submit", (event) => {
-    if ((event as SubmitEvent).submitter !== handOver) return; // Cancel closes the dialog
+    if (event.submitter !== handOver) return; // Cancel closes the dialog
     event.preventDefault();
     handOver.disabled = true;
     const user = select.value ? Number(select.value) : null;
-    postJson(`${workItemsUrl}${item}/reassign/`, { user }, csrfToken())
+    postJson(`${workItemsUrl}${item}/reassign/`, { user })
       .then(() => {
         dialog.close();
         void after();
@@ -363,9 +353,8 @@ function startIncidentsPage(config: IncidentsPageConfig): void {
 }
 
 function start(): void {
-  const source = document.getElementById("supervisor-page");
-  if (!source?.textContent) return;
-  const config = JSON.parse(source.textContent) as PageConfig;
+  const config = pageConfig<PageConfig>("supervisor-page");
+  if (!config) return;
   if (config.page === "case") startCasePage(config);
   else startIncidentsPage(config);
 }

@@ -3,6 +3,7 @@
 // (hrc/cases/views.py); these keep it up to date.
 
 import type { LiveEvent } from "../live/events";
+import { EVENT_TYPES, OPEN_WORK_ITEM_STATES, type Resolution } from "../shared/choices";
 import type { ConnectionStatus } from "../live/socket";
 import type { CaseJson, EventJson, IncidentJson, JobJson, Marking, WorkItemJson } from "./api";
 
@@ -95,30 +96,6 @@ export interface TimelineRow {
   detail: string;
 }
 
-export const EVENT_NAMES: Record<string, string> = {
-  "case-started": "Case started",
-  "case-suspended": "Case suspended",
-  "case-resumed": "Case resumed",
-  "case-cancelled": "Case cancelled",
-  "case-completed": "Case completed",
-  "case-failed": "Case failed",
-  "task-offered": "Task offered",
-  "task-claimed": "Task claimed",
-  "task-unclaimed": "Task unclaimed",
-  "task-reassigned": "Task reassigned",
-  "task-started": "Task started",
-  "task-completed": "Task completed",
-  "task-withdrawn": "Task withdrawn",
-  "task-interrupted": "Task interrupted",
-  "task-resumed": "Task resumed",
-  "transition-fired": "Transition fired",
-  "message-received": "Message received",
-  "step-retry": "Step will be retried",
-  "step-failed": "Step failed",
-  "incident-opened": "Incident opened",
-  "incident-resolved": "Incident resolved",
-};
-
 function short(value: unknown): string {
   const text = typeof value === "string" ? value : JSON.stringify(sortKeys(value));
   return text.length <= 80 ? text : `${text.slice(0, 79)}…`;
@@ -142,7 +119,7 @@ export function timelineRow(event: EventJson, labels: Record<string, string>): T
     at: event.at,
     when: formatTime(event.at),
     who: event.user || event.actor || "hrc",
-    what: EVENT_NAMES[event.type] ?? event.type,
+    what: EVENT_TYPES[event.type] ?? event.type,
     type: event.type,
     task: event.task,
     taskLabel: labels[event.task] ?? event.task,
@@ -175,8 +152,6 @@ export interface WorkRow {
   reassignable: boolean; // an operator task still open: a supervisor may hand it over
 }
 
-const OPEN_STATES: ReadonlySet<string> = new Set(["offered", "claimed", "running"]);
-
 function jobText(job: JobJson | null): string {
   if (!job) return "";
   if (job.state === "queued") {
@@ -196,11 +171,9 @@ export function workRow(item: WorkItemJson): WorkRow {
     who: item.claimed_by || item.job?.cobot_name || "–",
     job: jobText(item.job),
     id: item.id,
-    reassignable: item.kind === "operator" && OPEN_STATES.has(item.state),
+    reassignable: item.kind === "operator" && OPEN_WORK_ITEM_STATES.has(item.state),
   };
 }
-
-export type Resolution = "retry" | "skip" | "cancel";
 
 export type Checked<T> = { ok: true; value: T } | { ok: false; message: string };
 
@@ -240,22 +213,6 @@ export function outcomeText(incident: IncidentJson): string {
   const by = incident.resolved_by ? ` by ${incident.resolved_by}` : "";
   return `Resolved: ${incident.resolution}${by}`;
 }
-
-/** Incidents whose kind the page names (hrc/cases/choices.py IncidentKind). */
-export const INCIDENT_KINDS: Record<string, string> = {
-  "step-failed": "Cobot step failed",
-  "device-failed": "Device call failed",
-  "lease-expired": "Worker lost the job repeatedly",
-  "case-fault": "Case fault",
-};
-
-export const CASE_STATUSES: Record<string, string> = {
-  running: "Running",
-  suspended: "Suspended",
-  completed: "Completed",
-  cancelled: "Cancelled",
-  failed: "Failed",
-};
 
 /** The open incidents of a case as its detail carries them. */
 export function openIncidents(caseJson: CaseJson): IncidentJson[] {

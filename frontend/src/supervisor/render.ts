@@ -1,10 +1,10 @@
 // The page's DOM, kept the shape the server renders it in (templates/cases/): the net's
 // tokens and task states, incident cards, the open tasks, timeline rows.
 
+import { CASE_STATUSES, INCIDENT_KINDS } from "../shared/choices";
+import { element } from "../shared/dom";
 import type { IncidentJson, Marking } from "./api";
 import {
-  CASE_STATUSES,
-  INCIDENT_KINDS,
   constraintTokens,
   formatTime,
   outcomeText,
@@ -43,17 +43,6 @@ export function applyMarking(net: Element, marking: Marking, states: Map<string,
 export function applyStatus(badge: HTMLElement, status: string): void {
   badge.className = `status ${status}`;
   badge.textContent = CASE_STATUSES[status] ?? status;
-}
-
-function element<K extends keyof HTMLElementTagNameMap>(
-  tag: K,
-  attributes: Record<string, string> = {},
-  ...children: (Node | string)[]
-): HTMLElementTagNameMap[K] {
-  const node = document.createElement(tag);
-  for (const [name, value] of Object.entries(attributes)) node.setAttribute(name, value);
-  node.append(...children);
-  return node;
 }
 
 function time(iso: string): HTMLTimeElement {

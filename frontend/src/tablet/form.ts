@@ -133,7 +133,7 @@ function choice(row: HTMLElement, name: string, title: string, values: unknown[]
   }
   select.value = prefill !== undefined && values.some((v) => JSON.stringify(v) === JSON.stringify(prefill)) ? JSON.stringify(prefill) : "";
   row.append(select);
-  return () => (select.value === "" ? undefined : JSON.parse(select.value));
+  return () => (select.value === "" ? undefined : (JSON.parse(select.value) as unknown));
 }
 
 /** Two choices, Yes and No, as radio buttons: neither is chosen until the operator chooses. */

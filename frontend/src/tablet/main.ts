@@ -4,7 +4,8 @@ import "./tablet.css";
 import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
-import { ApiError, request } from "./api";
+import { element, pageConfig } from "../shared/dom";
+import { ApiError, problemOf, request } from "../shared/http";
 import { buildForm, type FormSchema } from "./form";
 import {
   activity,
@@ -39,7 +40,7 @@ const STATUS_TEXT: Record<ConnectionStatus, string> = {
 const MAX_MESSAGES = 20;
 
 const root = document.getElementById("tablet") as HTMLElement;
-const config = JSON.parse(document.getElementById("tablet-config")!.textContent!) as Config;
+const config = pageConfig<Config>("tablet-config")!;
 const $ = <T extends HTMLElement>(selector: string): T => root.querySelector(selector) as T;
 
 const store = new LiveStore();
@@ -225,7 +226,7 @@ function renderMessages(): void {
 // Actions -----------------------------------------------------------------------------------
 
 root.addEventListener("click", (event) => {
-  const button = (event.target as HTMLElement).closest("button[data-action]") as HTMLButtonElement | null;
+  const button = (event.target as HTMLElement).closest<HTMLButtonElement>("button[data-action]");
   if (!button) return;
   const id = Number(button.dataset.item);
   const action = button.dataset.action!;
@@ -239,7 +240,7 @@ async function act(button: HTMLButtonElement, url: string, body?: unknown): Prom
     await request("POST", url, body ?? {});
     return true;
   } catch (error) {
-    flash(error instanceof ApiError ? error.message : String(error));
+    flash(problemOf(error));
     return false;
   } finally {
     button.disabled = false;
@@ -252,7 +253,7 @@ async function openForm(id: number): Promise<void> {
   try {
     detail = await request("GET", `/api/work-items/${id}/`);
   } catch (error) {
-    flash(error instanceof ApiError ? error.message : String(error));
+    flash(problemOf(error));
     return;
   }
   const form = element("form", "task-form");
@@ -270,8 +271,7 @@ async function openForm(id: number): Promise<void> {
   const actions = element("div", "actions");
   actions.append(cancel, submit);
   form.append(element("h2", "", detail.label), element("p", "instructions", detail.instructions), fields, error, actions);
-  form.addEventListener("submit", async (event) => {
-    event.preventDefault();
+  const complete = async (): Promise<void> => {
     error.textContent = "";
     // Required answers are asked for here, at their fields; the server refuses them too.
     if (!answers.check()) {
@@ -287,11 +287,15 @@ async function openForm(id: number): Promise<void> {
         const rest = answers.showErrors(failure.fields);
         error.textContent = rest.length ? rest.join(" ") : "Correct the answers marked above.";
       } else {
-        error.textContent = failure instanceof ApiError ? failure.message : String(failure);
+        error.textContent = problemOf(failure);
       }
     } finally {
       submit.disabled = false;
     }
+  };
+  form.addEventListener("submit", (event) => {
+    event.preventDefault();
+    void complete();
   });
   dialog.replaceChildren(form);
   dialog.showModal();
@@ -320,13 +324,6 @@ function flash(text: string): void {
   note.setAttribute("role", "alert");
   connection.after(note);
   setTimeout(() => note.remove(), 6000);
-}
-
-function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = "", text?: string): HTMLElementTagNameMap[K] {
-  const node = document.createElement(tag);
-  if (className) node.className = className;
-  if (text !== undefined) node.textContent = text;
-  return node;
 }
 
 // For the browser tests and a curious engineer's console.

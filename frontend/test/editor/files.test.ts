@@ -1,6 +1,6 @@
 import { expect, test } from "vitest";
 
-import { errorMessage } from "../../src/editor/api";
+import { refusalMessage } from "../../src/shared/http";
 import { DocumentError } from "../../src/editor/model/document";
 import { inspectFile, openElementNear } from "../../src/editor/model/files";
 import { example } from "./helpers";
@@ -53,12 +53,12 @@ test("the element still open at an error is the one named", () => {
 });
 
 test("the API's refusals read as one message", () => {
-  expect(errorMessage(400, { detail: "The draft does not pass the check; see the report.", report: { valid: false } })).toBe(
+  expect(refusalMessage(400, { detail: "The draft does not pass the check; see the report.", report: { valid: false } })).toBe(
     "The draft does not pass the check; see the report.",
   );
-  expect(errorMessage(400, { detail: "Not readable:", errors: [{ code: "format", message: "bpmn:boundaryEvent b1 is not mapped.", elements: ["b1"] }] })).toBe(
+  expect(refusalMessage(400, { detail: "Not readable:", errors: [{ code: "format", message: "bpmn:boundaryEvent b1 is not mapped.", elements: ["b1"] }] })).toBe(
     "Not readable: bpmn:boundaryEvent b1 is not mapped.",
   );
-  expect(errorMessage(400, { name: ["This field may not be blank."] })).toBe("name: This field may not be blank.");
-  expect(errorMessage(502, "<html>")).toBe("The server answered 502.");
+  expect(refusalMessage(400, { name: ["This field may not be blank."] })).toBe("name: This field may not be blank.");
+  expect(refusalMessage(502, "<html>")).toBe("The server answered 502.");
 });

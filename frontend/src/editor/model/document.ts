@@ -181,7 +181,7 @@ class Reader {
       this.fail("The document has no process: a pattern needs at least one Petri net.");
     }
     const constraints = this.list(data, "constraints", "", (item, at) => this.constraint(item, at));
-    return { ...structuredClone(data), format: FORMAT, actors, processes, constraints } as PatternDocument;
+    return { ...structuredClone(data), format: FORMAT, actors, processes, constraints };
   }
 
   actor(value: unknown, where: string): ActorData | null {

@@ -4,11 +4,10 @@
  * then c2, o2… Ids are unique across the whole document.
  */
 
-import type { ActorType } from "./document";
-
 export type IdKind = "place" | "silent" | "task" | "actor" | "process";
 
-export function nextId(kind: IdKind, taken: (id: string) => boolean, actor?: string | ActorType): string {
+/** `actor`: the task's actor id for a task, the ActorType for an actor. */
+export function nextId(kind: IdKind, taken: (id: string) => boolean, actor?: string): string {
   const prefix = {
     place: "p",
     silent: "t",

@@ -30,8 +30,10 @@ export function jsonProblem(text: string): JsonProblem | null {
   }
 }
 
-class SyntaxProblem {
-  constructor(readonly at: number) {}
+class SyntaxProblem extends Error {
+  constructor(readonly at: number) {
+    super(`JSON syntax error at ${at}`);
+  }
 }
 
 class Scanner {

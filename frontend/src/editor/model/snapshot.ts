@@ -127,11 +127,12 @@ export function toDocument(snapshot: Snapshot): PatternDocument {
   );
   const byId = new Map(processes.map((process) => [process.id, process]));
   const processOfNode = new Map<string, ProcessData>();
+  const fallbackProcess = byId.get(fallback) ?? processes[0];
   for (const node of snapshot.nodes) {
-    const process = byId.get(node.process) ?? (byId.get(fallback) as ProcessData);
+    const process = byId.get(node.process) ?? fallbackProcess;
     const data = { ...structuredClone(node.data), layout: withCentre(node.data.layout, node) };
-    if (node.kind === "place") process.places.push(data as PlaceData);
-    else process.transitions.push(data as TransitionData);
+    if (node.kind === "place") process.places.push(data);
+    else process.transitions.push(data);
     processOfNode.set(node.data.id, process);
   }
   for (const arc of snapshot.arcs) {
@@ -151,7 +152,7 @@ export function toDocument(snapshot: Snapshot): PatternDocument {
     processes,
     constraints: structuredClone(snapshot.constraints),
     layout,
-  } as PatternDocument;
+  };
 }
 
 /**

@@ -24,6 +24,8 @@ export const DEVICE_CALLS: Record<string, string[]> = {
   "place-position.check": [],
   "place-position.wait": ["timeout_ms"],
 };
+/** How a space constraint's cobot makes way (its `interrupt` key), as the panel words it; pause is the default. */
+export const INTERRUPT_MODES: Record<string, string> = { pause: "pauses", slow: "slows down" };
 export const POSE_LENGTH = 6;
 export const MAX_POSES = 2;
 export const FIELD_TYPES = ["string", "integer", "number", "boolean"] as const;
@@ -83,7 +85,7 @@ export function parsePoses(text: string): unknown {
     try {
       return parsePose(line);
     } catch (error) {
-      throw new Error(`Pose ${index + 1}: ${(error as Error).message}`);
+      throw new Error(`Pose ${index + 1}: ${(error as Error).message}`, { cause: error });
     }
   });
 }

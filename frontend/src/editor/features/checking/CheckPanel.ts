@@ -9,6 +9,7 @@ import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
 import type Selection from "diagram-js/lib/features/selection/Selection";
 import type Canvas from "diagram-js/lib/core/Canvas";
 
+import { addElement, element } from "../../../shared/dom";
 import type { CheckIssue, CheckReport } from "../../api";
 import type TokenGameMode from "../token-game/TokenGameMode";
 import { listOfNames } from "../../model/words";
@@ -34,20 +35,20 @@ export default class CheckPanel {
     private readonly canvas: Canvas,
     private readonly tokenGame: TokenGameMode,
   ) {
-    this.badge = element("output", "hrc-pattern-badge", shell.toolbar);
+    this.badge = addElement(shell.toolbar, "output", "hrc-pattern-badge");
     this.badge.setAttribute("aria-label", "Pattern class");
     this.badge.setAttribute("aria-live", "polite");
-    const section = element("section", "hrc-check", shell.side);
+    const section = addElement(shell.side, "section", "hrc-check");
     section.setAttribute("aria-label", "Check");
-    element("h2", "", section).textContent = "Check";
-    this.list = element("div", "hrc-issues", section);
+    addElement(section, "h2", "", "Check");
+    this.list = addElement(section, "div", "hrc-issues");
     this.badge.textContent = "Not checked yet";
     eventBus.on("check.pending", () => this.badge.classList.add("hrc-pending"));
     eventBus.on("check.report", (event: { report: CheckReport }) => this.show(event.report));
     eventBus.on("check.failed", (event: { message: string }) => {
       this.badge.classList.remove("hrc-pending");
       this.badge.textContent = "Check failed";
-      this.list.replaceChildren(paragraph(`The server could not check the model: ${event.message}`, "hrc-error"));
+      this.list.replaceChildren(element("p", "hrc-error", `The server could not check the model: ${event.message}`));
     });
   }
 
@@ -63,7 +64,7 @@ export default class CheckPanel {
       ...report.warnings.map((issue) => this.item(issue, "warning")),
     ];
     const summary = report.valid ? "No errors: the model is valid and sound." : `${report.errors.length} error${report.errors.length === 1 ? "" : "s"}.`;
-    this.list.replaceChildren(paragraph(summary, report.valid ? "hrc-ok" : "hrc-error"), ...items);
+    this.list.replaceChildren(element("p", report.valid ? "hrc-ok" : "hrc-error", summary), ...items);
   }
 
   private nameOf(id: string): string {
@@ -71,11 +72,7 @@ export default class CheckPanel {
   }
 
   private item(issue: CheckIssue, severity: "error" | "warning"): HTMLElement {
-    const item = document.createElement("article");
-    item.className = `hrc-issue hrc-${severity}`;
-    item.dataset.code = issue.code;
-    const text = element("p", "", item);
-    text.textContent = issue.message;
+    const item = element("article", { class: `hrc-issue hrc-${severity}`, "data-code": issue.code }, element("p", "", issue.message));
     const known = issue.elements.filter((id) => this.elementRegistry.get(id));
     if (known.length) {
       const show = button(`Show ${listOfNames(known, (id) => this.nameOf(id))}`, item);
@@ -89,11 +86,9 @@ export default class CheckPanel {
     if (issue.witness) {
       const play = button("Play the witness", item);
       play.classList.add("hrc-play-witness");
-      const steps = element("ol", "hrc-witness-steps", item);
+      const steps = addElement(item, "ol", "hrc-witness-steps");
       for (const label of issue.witness) {
-        const step = element("li", "", steps);
-        step.textContent = this.tokenGame.stepWords(label);
-        step.dataset.firing = label;
+        addElement(steps, "li", { "data-firing": label }, this.tokenGame.stepWords(label));
       }
       play.addEventListener("click", () => void this.tokenGame.replay(issue.witness as string[], issue.elements));
     }
@@ -101,24 +96,6 @@ export default class CheckPanel {
   }
 }
 
-function element(tag: string, className: string, parent: HTMLElement): HTMLElement {
-  const node = document.createElement(tag);
-  if (className) node.className = className;
-  parent.appendChild(node);
-  return node;
-}
-
 function button(text: string, parent: HTMLElement): HTMLButtonElement {
-  const node = document.createElement("button");
-  node.type = "button";
-  node.textContent = text;
-  parent.appendChild(node);
-  return node;
-}
-
-function paragraph(text: string, className: string): HTMLElement {
-  const node = document.createElement("p");
-  node.className = className;
-  node.textContent = text;
-  return node;
+  return addElement(parent, "button", { type: "button" }, text);
 }

@@ -14,7 +14,8 @@ import type PatternModeling from "../modeling/PatternModeling";
 export default class LabelEditing {
   static $inject = ["eventBus", "canvas", "modeling"];
 
-  private input: HTMLInputElement | null = null;
+  /** The open field and the element whose label it edits; null while none is open. */
+  private editing: { input: HTMLInputElement; shape: Shape } | null = null;
 
   constructor(
     eventBus: EventBus,
@@ -33,7 +34,7 @@ export default class LabelEditing {
   }
 
   isActive(): boolean {
-    return this.input !== null;
+    return this.editing !== null;
   }
 
   activate(shape: Shape): void {
@@ -53,19 +54,17 @@ export default class LabelEditing {
     });
     input.addEventListener("blur", () => this.finish(false));
     this.canvas.getContainer().appendChild(input);
-    this.input = input;
-    (input as HTMLInputElement & { shape?: Shape }).shape = shape;
+    this.editing = { input, shape };
     input.focus();
     input.select();
   }
 
   /** Closes the field; keeps the text unless cancelled and unchanged text changes nothing. */
   finish(cancel: boolean): void {
-    const input = this.input as (HTMLInputElement & { shape?: Shape }) | null;
-    if (!input) return;
-    this.input = null;
+    if (!this.editing) return;
+    const { input, shape } = this.editing;
+    this.editing = null;
     input.remove();
-    const shape = input.shape as Shape;
     const object = objectOf(shape) as { data: { label?: unknown } };
     const before = typeof object.data.label === "string" ? object.data.label : "";
     if (!cancel && input.value.trim() !== before) this.modeling.updateLabel(shape, input.value);

@@ -14,7 +14,8 @@ import { objectOf, performerOf } from "../../core/elements";
 
 const ABSENT = Symbol("absent");
 
-type Old = Record<string, unknown | typeof ABSENT>;
+// A key's value before the update, or ABSENT where the key was not there.
+type Old = Record<string, unknown>;
 
 export interface UpdateDataContext extends CommandContext {
   element: ElementLike;

@@ -41,9 +41,9 @@ export default class PaletteProvider {
 
   getPaletteEntries(): Record<string, Entry> {
     return {
-      "hand-tool": this.tool("Hand tool: pan the canvas (H)", "hand", (event) => this.handTool.activateHand(event as MouseEvent)),
+      "hand-tool": this.tool("Hand tool: pan the canvas (H)", "hand", (event) => this.handTool.activateHand(event)),
       "lasso-tool": this.tool("Lasso: select several elements (L)", "lasso", (event) => this.lassoTool.activateSelection(event as MouseEvent)),
-      "global-connect-tool": this.tool("Arc: connect a place and a transition (C)", "arc", (event) => this.globalConnect.start(event as MouseEvent, undefined)),
+      "global-connect-tool": this.tool("Arc: connect a place and a transition (C)", "arc", (event) => this.globalConnect.start(event, undefined)),
       "create.place": this.node("Place", "place", { kind: "place", process: "", data: { id: "" } }),
       "create.task": this.node("Task (drop it in an actor's lane)", "task", { kind: "transition", process: "", silent: false, data: { id: "", label: "" } }),
       "create.silent": this.node("Silent transition (split or join)", "silent", { kind: "transition", process: "", silent: true, data: { id: "" } }),

@@ -10,6 +10,7 @@ import type Selection from "diagram-js/lib/features/selection/Selection";
 import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
 import { PATTERN_NAMES } from "../../model/document";
+import { INTERRUPT_MODES } from "../../model/taskconfig";
 import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
@@ -17,7 +18,8 @@ import { quotedName } from "../../model/words";
 import { isLane, lanesTopDown, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
-import { add, button, field, heading, note, select } from "./fields";
+import { addElement } from "../../../shared/dom";
+import { button, field, heading, note, select } from "./fields";
 import { taskSection } from "./TaskSection";
 
 type Element = Shape | Connection;
@@ -37,7 +39,7 @@ export default class PropertiesPanel {
     private readonly elementFactory: PatternElementFactory,
     private readonly deviceCalls: Record<string, string[]>,
   ) {
-    this.panel = add(shell.side, "section", "hrc-properties");
+    this.panel = addElement(shell.side, "section", "hrc-properties");
     this.panel.setAttribute("aria-label", "Properties");
     eventBus.on(["selection.changed", "import.done", "commandStack.changed"], () => this.render());
   }
@@ -46,7 +48,7 @@ export default class PropertiesPanel {
     const selected = this.selection.get() as Element[];
     this.panel.replaceChildren();
     const element = selected.length === 1 ? selected[0] : null;
-    const object = objectOf(element) as PatternObject | undefined;
+    const object = objectOf(element);
     if (selected.length > 1) {
       note(this.panel, `${selected.length} elements selected.`);
       return;
@@ -138,7 +140,7 @@ export default class PropertiesPanel {
     reverse.title = "Swap the two tasks: the constraint then runs the other way";
     select(this.panel, "Kind", object.data.type, CONSTRAINT_TYPES.map((type): [string, string] => [type, type]), (type) => this.modeling.updateData(connection, { type, interrupt: type === "space" ? object.data.interrupt : undefined }));
     if (object.data.type === "space") {
-      select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), [["pause", "pauses"], ["slow", "slows down"]], (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));
+      select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), Object.entries(INTERRUPT_MODES), (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));
     }
   }
 

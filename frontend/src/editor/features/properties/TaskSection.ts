@@ -22,7 +22,8 @@ import {
 import type { ActorType } from "../../model/document";
 import type { TransitionObject } from "../../core/elements";
 import type PatternModeling from "../modeling/PatternModeling";
-import { add, button, checkbox, field, heading, note, select } from "./fields";
+import { addElement } from "../../../shared/dom";
+import { button, checkbox, field, heading, note, select } from "./fields";
 
 export function taskSection(
   parent: HTMLElement,
@@ -106,10 +107,10 @@ function deviceEditor(parent: HTMLElement, task: Extra, setKey: (key: string, va
 
 function formEditor(parent: HTMLElement, task: Extra, setKey: (key: string, value: unknown) => void): void {
   const fields = fieldsOfForm(task.form);
-  add(parent, "h4", "").textContent = "Form fields the operator fills in";
+  addElement(parent, "h4", "").textContent = "Form fields the operator fills in";
   const save = (next: FormField[]) => setKey("form", formOfFields(next, task.form));
   fields.forEach((formField, index) => {
-    const row = add(parent, "div", "hrc-form-row");
+    const row = addElement(parent, "div", "hrc-form-row");
     const update = (change: Partial<FormField>) => save(fields.map((f, i) => (i === index ? { ...f, ...change } : f)));
     field(row, { label: "Name", value: formField.name, commit: (text) => update({ name: text.trim() }) });
     field(row, { label: "Title", value: formField.title, commit: (text) => update({ title: text.trim() }) });

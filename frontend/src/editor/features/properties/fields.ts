@@ -1,5 +1,7 @@
 /** Form controls for the properties panel: each commits on change and shows its own error. */
 
+import { addElement } from "../../../shared/dom";
+
 export interface FieldOptions {
   label: string;
   value: string;
@@ -17,20 +19,20 @@ let fieldCount = 0;
 function labelled(parent: HTMLElement, text: string, control: HTMLElement, hint?: string): HTMLElement {
   fieldCount += 1;
   const id = `hrc-field-${fieldCount}`;
-  const wrapper = add(parent, "div", "hrc-field");
-  const label = add(wrapper, "label", "hrc-field-label") as HTMLLabelElement;
+  const wrapper = addElement(parent, "div", "hrc-field");
+  const label = addElement(wrapper, "label", "hrc-field-label");
   label.htmlFor = id;
   label.textContent = text;
   control.id = id;
   wrapper.appendChild(control);
   const described: string[] = [];
   if (hint) {
-    const small = add(wrapper, "small", "hrc-hint");
+    const small = addElement(wrapper, "small", "hrc-hint");
     small.id = `${id}-hint`;
     small.textContent = hint;
     described.push(small.id);
   }
-  const error = add(wrapper, "span", "hrc-field-error");
+  const error = addElement(wrapper, "span", "hrc-field-error");
   error.id = `${id}-error`;
   error.setAttribute("role", "alert");
   described.push(error.id);
@@ -52,7 +54,7 @@ export function field(parent: HTMLElement, options: FieldOptions): HTMLInputElem
 export function select(parent: HTMLElement, label: string, value: string, choices: [string, string][], commit?: (value: string) => void): HTMLSelectElement {
   const input = document.createElement("select");
   for (const [choice, text] of choices) {
-    const option = add(input, "option", "") as HTMLOptionElement;
+    const option = addElement(input, "option", "");
     option.value = choice;
     option.textContent = text;
   }
@@ -64,7 +66,7 @@ export function select(parent: HTMLElement, label: string, value: string, choice
 }
 
 export function checkbox(parent: HTMLElement, label: string, checked: boolean, commit: (checked: boolean) => void): HTMLInputElement {
-  const wrapper = add(parent, "label", "hrc-check-field");
+  const wrapper = addElement(parent, "label", "hrc-check-field");
   const input = document.createElement("input");
   input.type = "checkbox";
   input.checked = checked;
@@ -74,27 +76,20 @@ export function checkbox(parent: HTMLElement, label: string, checked: boolean, c
 }
 
 export function heading(parent: HTMLElement, text: string): void {
-  add(parent, "h3", "").textContent = text;
+  addElement(parent, "h3", "").textContent = text;
 }
 
 export function note(parent: HTMLElement, text: string): HTMLElement {
-  const node = add(parent, "p", "hrc-note");
+  const node = addElement(parent, "p", "hrc-note");
   node.textContent = text;
   return node;
 }
 
 export function button(parent: HTMLElement, text: string, run: () => void): HTMLButtonElement {
-  const node = add(parent, "button", "") as HTMLButtonElement;
+  const node = addElement(parent, "button", "");
   node.type = "button";
   node.textContent = text;
   node.addEventListener("click", run);
-  return node;
-}
-
-export function add(parent: HTMLElement, tag: string, className: string): HTMLElement {
-  const node = document.createElement(tag);
-  if (className) node.className = className;
-  parent.appendChild(node);
   return node;
 }
 

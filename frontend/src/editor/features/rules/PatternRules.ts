@@ -104,12 +104,12 @@ export default class PatternRules extends RuleProvider {
     const kind = this.connectMode.kind;
     const reason =
       kind === "arc"
-        ? arcRefusal(this.info(source), this.info(target as Shape), this.arcs())
-        : constraintRefusal(this.info(source), this.info(target as Shape), kind, this.constraints());
+        ? arcRefusal(this.info(source), this.info(target), this.arcs())
+        : constraintRefusal(this.info(source), this.info(target), kind, this.constraints());
     if (reason) return this.refusals.refuse(reason);
     this.allowed();
     if (kind === "arc") return { businessObject: { kind: "arc" } };
-    return { businessObject: { kind: "constraint", data: { from: source.id, to: (target as Shape).id, type: kind } } };
+    return { businessObject: { kind: "constraint", data: { from: source.id, to: target.id, type: kind } } };
   }
 
   private canReconnect(connection: Connection, source: Shape, target: Shape): boolean {
