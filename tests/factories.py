@@ -11,6 +11,7 @@ from typing import Any
 from django.contrib.auth.models import User
 from django.db import transaction
 
+from hrc.cases import events as case_events
 from hrc.cases import services as case_services
 from hrc.cases.choices import OPEN_WORK_ITEM_STATES, IncidentKind
 from hrc.cases.models import Case, Incident, WorkItem
@@ -239,7 +240,7 @@ def make_incident(item: WorkItem, message: str = "The step failed.") -> Incident
     """An open incident about a work item, as a worker opens one (holding the case row lock)."""
     with transaction.atomic():
         case = Case.objects.select_for_update().get(pk=item.case_id)
-        incident = case_services.open_incident(
+        incident = case_events.open_incident(
             case, IncidentKind.STEP_FAILED, message, item=item, cobot_state={"RobotMode": 7}
         )
         case.save()

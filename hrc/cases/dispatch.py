@@ -8,6 +8,10 @@ job that is due from the rows themselves. So a failed send is logged, not raised
 without workers, and the embedded demo); everything else stays the same.
 The embedded demo has no Celery beat either: `start_embedded_sweeper` runs
 the sweeper on a thread of the server instead.
+
+Tasks go by their registered name (Task), never by importing tasks.py, which
+imports the modules that send them; tests/cases/test_dispatch.py checks that
+every name is a registered task.
 """
 
 from __future__ import annotations
@@ -19,46 +23,64 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, ThreadPoolExecutor
 from contextlib import contextmanager
+from enum import StrEnum
 from typing import Any
 
+from celery import Task as CeleryTask
 from django.conf import settings
 from django.db import connections, transaction
+
+from hrc.celery import app
 
 logger = logging.getLogger(__name__)
 
 _inline: Executor | None = None
 
 
-def send_on_commit(task_name: str, *args: Any, countdown: float = 0) -> None:
-    """Sends the Celery task `hrc.cases.tasks.<task_name>`(*args) once the transaction commits."""
-    transaction.on_commit(lambda: _send(task_name, args, countdown))
+class Task(StrEnum):
+    """The Celery tasks of the cases app, by the names tasks.py registers them under."""
+
+    RUN_JOB = "hrc.cases.tasks.run_job"
+    SWEEP = "hrc.cases.tasks.sweep"
+    INTERRUPT_COBOT = "hrc.cases.tasks.interrupt_cobot"
+    RESUME_COBOT = "hrc.cases.tasks.resume_cobot"
+    PURGE_MESSAGES = "hrc.cases.tasks.purge_messages"
 
 
-def send_on_commit_if(wanted: Callable[[], bool], task_name: str, *args: Any) -> None:
+def send_on_commit(task: Task, *args: Any, countdown: float = 0) -> None:
+    """Sends the Celery task `task`(*args) once the transaction commits."""
+    transaction.on_commit(lambda: _send(task, args, countdown))
+
+
+def send_on_commit_if(wanted: Callable[[], bool], task: Task, *args: Any) -> None:
     """send_on_commit, when `wanted()`, asked once the transaction has committed, says so."""
 
     def send() -> None:
         if wanted():
-            _send(task_name, args, 0)
+            _send(task, args, 0)
 
     transaction.on_commit(send)
 
 
-def _send(task_name: str, args: tuple[Any, ...], countdown: float) -> None:
-    from hrc.cases import tasks  # the tasks module imports the services that import this one
-
-    task = getattr(tasks, task_name)
+def _send(task: Task, args: tuple[Any, ...], countdown: float) -> None:
     executor = _inline
     if executor is None and settings.HRC_INLINE_TASKS:
         executor = _embedded_pool()
         start_embedded_sweeper()
     if executor is not None:
-        _submit_inline(executor, task.run, args, countdown)
+        _submit_inline(executor, registered(task).run, args, countdown)
         return
     try:
-        task.apply_async(args, countdown=countdown or None)
+        # The cases' tasks keep no results (ignore_result on each): say so as apply_async would.
+        app.send_task(task.value, args, countdown=countdown or None, ignore_result=True)
     except Exception as error:  # the broker is down: the sweeper will find the row
-        logger.warning("Could not send %s%s (%s); the sweeper will", task_name, args, error)
+        logger.warning("Could not send %s%s (%s); the sweeper will", task.value, args, error)
+
+
+def registered(task: Task) -> CeleryTask:
+    """The Celery task of that name, as the app registered it (hrc.cases.receivers imports
+    tasks.py at start-up, so it is there in every process). KeyError when it is not."""
+    return app.tasks[task.value]
 
 
 def _submit_inline(
@@ -93,13 +115,12 @@ def start_embedded_sweeper() -> threading.Thread:
     Without it a job whose doorbell was lost (the server stopped mid-case)
     would wait forever. Once per process; the server calls it at start-up.
     """
-    from hrc.cases import tasks
 
     def ring() -> None:
         while True:
             time.sleep(settings.HRC_SWEEP_SECONDS)
             if settings.HRC_INLINE_TASKS:  # settings can change under tests
-                _submit_inline(_embedded_pool(), tasks.sweep.run, (), 0)
+                _submit_inline(_embedded_pool(), registered(Task.SWEEP).run, (), 0)
 
     thread = threading.Thread(target=ring, name="hrc-sweeper", daemon=True)
     thread.start()

@@ -18,6 +18,7 @@ from django.utils import timezone
 
 from hrc.cases import dispatch
 from hrc.cases.choices import JobState
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
 from hrc.cobots import urua
 from hrc.cobots.drivers.base import DriverError
@@ -108,15 +109,15 @@ def resume_cobot(interruption_id: int) -> None:
     )
     if job_id is not None:
         with transaction.atomic():
-            dispatch.send_on_commit("run_job", job_id)
+            dispatch.send_on_commit(Task.RUN_JOB, job_id)
 
 
-def to_redo() -> list[tuple[str, int]]:
+def to_redo() -> list[tuple[Task, int]]:
     """Pauses that failed while the interruption is open, resumes not yet done after it ended."""
     pauses = Interruption.objects.filter(ended_at__isnull=True, paused_at__isnull=True).exclude(
         error=""
     )
     resumes = Interruption.objects.filter(ended_at__isnull=False, resumed_at__isnull=True)
-    return [("interrupt_cobot", pk) for pk in pauses.values_list("pk", flat=True)] + [
-        ("resume_cobot", pk) for pk in resumes.values_list("pk", flat=True)
+    return [(Task.INTERRUPT_COBOT, pk) for pk in pauses.values_list("pk", flat=True)] + [
+        (Task.RESUME_COBOT, pk) for pk in resumes.values_list("pk", flat=True)
     ]

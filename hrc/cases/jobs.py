@@ -32,7 +32,7 @@ from django.db import transaction
 from django.db.models import Exists, OuterRef, Q, QuerySet
 from django.utils import timezone
 
-from hrc.cases import dispatch, interruptions, services
+from hrc.cases import dispatch, events, interruptions, progress
 from hrc.cases.choices import (
     OPEN_CASE_STATUSES,
     CaseStatus,
@@ -42,6 +42,7 @@ from hrc.cases.choices import (
     WorkItemKind,
     WorkItemState,
 )
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
@@ -59,7 +60,6 @@ from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet
-from hrc.live import broadcast as live
 
 logger = logging.getLogger(__name__)
 
@@ -87,8 +87,8 @@ class Lease:
 def run_next_job(job_id: int) -> None:
     """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
-    # started, the queue) waits until the cobot has accepted the step (hrc/live/broadcast.py).
-    hold = live.hold()
+    # started, the queue) waits until the cobot has accepted the step (events.hold_publishing).
+    hold = events.hold_publishing()
     # When the cobot accepted the step: its work starts there, not at the lease (analytics).
     accepted: list[dt.datetime] = []
 
@@ -199,17 +199,17 @@ def _lease_if_ready(
         if job.waiting_for != waiting:
             job.waiting_for = waiting
             job.save(update_fields=["waiting_for"])
-            live.cobot_queue_on_commit(cobot.pk)
+            events.publish_cobot_queue(cobot.pk)
         return None
     if item.state == WorkItemState.OFFERED:
-        services.start_cobot_task(case, net, item)
+        progress.start_cobot_task(case, net, item)
     job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
     job.held_by = f"{socket.gethostname()}:{os.getpid()}"
     job.started_at = job.started_at or now
     job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
     job.save(update_fields=LEASED_FIELDS)
     case.save()
-    live.cobot_queue_on_commit(cobot.pk)
+    events.publish_cobot_queue(cobot.pk)
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
         sent_before=job.sent_at is not None,
@@ -218,7 +218,7 @@ def _lease_if_ready(
 
 def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
     """Both rows locked, in the project's lock order (case, then job); the work item read along."""
-    case = services.lock_case(case_id)
+    case = progress.lock_case(case_id)
     job = (
         Job.objects.select_for_update(of=("self",), no_key=True)
         .select_related("work_item")
@@ -356,15 +356,15 @@ def finish_job(
         job.accepted_at = accepted_at or job.started_at
         job.save(update_fields=["state", "result", "ended_at", "accepted_at"])
         if case.status in OPEN_CASE_STATUSES:
-            services.complete_cobot_task(case, case_net(case.version), job.work_item, result)
+            progress.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
         _ring_for_next_on_commit(job)
 
 
 def _ring_for_next_on_commit(job: Job) -> None:
     """Rings the cobot's doorbell for its next job once this transaction has committed, if one
-    is queued then (services.ring_for_next_job_on_commit)."""
-    services.ring_for_next_job_on_commit(job.pk, job.cobot_id)
+    is queued then (progress.ring_for_next_job_on_commit)."""
+    progress.ring_for_next_job_on_commit(job.pk, job.cobot_id)
 
 
 def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | None = None) -> None:
@@ -385,11 +385,11 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
             # the pause to end (an interruption settled, a STOP resumed) before it leases again.
             job.state, job.next_try_at = JobState.QUEUED, timezone.now()
             job.save()
-            services.record_event(
+            events.record_event(
                 case, EventType.STEP_RETRY, item=item,
                 detail={"error": str(error), "in_seconds": 0, "retries_left": job.retries_left},
             )  # fmt: skip
-            dispatch.send_on_commit("run_job", job.pk)
+            dispatch.send_on_commit(Task.RUN_JOB, job.pk)
         elif error.transient and job.retries_left > 0:
             job.retries_left -= 1
             delay = _backoff(case_net(case.version).tasks[item.task].retries - job.retries_left)
@@ -398,15 +398,15 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
                 timezone.now() + dt.timedelta(seconds=delay),
             )
             job.save()
-            services.record_event(
+            events.record_event(
                 case, EventType.STEP_RETRY, item=item,
                 detail={"error": str(error), "in_seconds": delay, "retries_left": job.retries_left},
             )  # fmt: skip
-            dispatch.send_on_commit("run_job", job.pk, countdown=delay)
+            dispatch.send_on_commit(Task.RUN_JOB, job.pk, countdown=delay)
         else:
             job.state, job.ended_at = JobState.FAILED, timezone.now()
             job.save()
-            services.record_event(
+            events.record_event(
                 case, EventType.STEP_FAILED, item=item,
                 detail={"error": str(error), "attempt": job.attempt},
             )  # fmt: skip
@@ -415,7 +415,7 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
                 if job.kind == WorkItemKind.DEVICE
                 else IncidentKind.STEP_FAILED
             )
-            services.open_incident(case, kind, str(error), item=item, cobot_state=error.state)
+            events.open_incident(case, kind, str(error), item=item, cobot_state=error.state)
             _ring_for_next_on_commit(job)  # the cobot's next job may go
         case.save()
 
@@ -429,7 +429,7 @@ def _ended_with_case(case: Case, job: Job) -> bool:
         return False
     job.state, job.ended_at = JobState.CANCELLED, timezone.now()
     job.save()
-    live.cobot_queue_on_commit(job.cobot_id)
+    events.publish_cobot_queue(job.cobot_id)
     _ring_for_next_on_commit(job)
     return True
 
@@ -469,10 +469,10 @@ def sweep() -> dict[str, int]:
     due = _first_due_per_cobot(now)
     with transaction.atomic():  # send_on_commit needs a transaction to wait for
         for job_id in due:
-            dispatch.send_on_commit("run_job", job_id)
+            dispatch.send_on_commit(Task.RUN_JOB, job_id)
         unsettled = interruptions.to_redo()
-        for task_name, interruption_id in unsettled:
-            dispatch.send_on_commit(task_name, interruption_id)
+        for task, interruption_id in unsettled:
+            dispatch.send_on_commit(task, interruption_id)
     return {"expired": len(expired), "rung": len(due), "interruptions": len(unsettled)}
 
 
@@ -508,7 +508,7 @@ def _expire_lease(job_id: int, case_id: int) -> None:
         if job.lease_expiries >= MAX_LEASE_EXPIRIES:
             job.state, job.ended_at = JobState.FAILED, timezone.now()
             job.save()
-            services.open_incident(
+            events.open_incident(
                 case, IncidentKind.LEASE_EXPIRED,
                 f"Workers lost job {job.pk} ({job.work_item.label}) {job.lease_expiries} times; "
                 "check the workers' logs, then retry, skip or cancel.",
@@ -518,5 +518,5 @@ def _expire_lease(job_id: int, case_id: int) -> None:
             job.state, job.next_try_at = JobState.QUEUED, timezone.now()
             job.save()
         case.save()
-        live.cobot_queue_on_commit(job.cobot_id)
-        dispatch.send_on_commit("run_job", job.pk)
+        events.publish_cobot_queue(job.cobot_id)
+        dispatch.send_on_commit(Task.RUN_JOB, job.pk)

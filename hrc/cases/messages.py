@@ -17,12 +17,11 @@ from django.contrib.auth.models import User
 from django.db import IntegrityError, transaction
 from django.utils import timezone
 
-from hrc.cases.choices import CaseStatus, EventType
+from hrc.cases import progress
+from hrc.cases.choices import CaseStatus
 from hrc.cases.errors import Conflict, Invalid
 from hrc.cases.models import Case, Message
 from hrc.cases.nets import case_net
-from hrc.engine.petri import Marking
-from hrc.engine.runtime import CaseNet, correlates
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
 
@@ -87,8 +86,6 @@ def _same_message(
 
 def _deliver(message: Message) -> None:
     """Offers the message to each running case of the organisation waiting for its name."""
-    from hrc.cases import services
-
     running = Case.objects.filter(
         organisation_id=message.organisation_id, status=CaseStatus.RUNNING
     )
@@ -103,49 +100,14 @@ def _deliver(message: Message) -> None:
     )
     for case_id in candidates:
         with transaction.atomic():
-            case = services.lock_case(case_id)
+            case = progress.lock_case(case_id)
             if case.status != CaseStatus.RUNNING:
                 continue
             net = case_net(case.version)
-            if take_buffered_message(case, net, only=message.pk):
-                services.advance(case, net)
+            if progress.take_buffered_message(case, net, only=message.pk):
+                progress.advance(case, net)
                 case.save()
                 return
-
-
-def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> bool:
-    """Fires a waiting message transition with the oldest matching unexpired message, if any.
-
-    Call while holding the case row lock. Returns whether a message was taken.
-    """
-    from hrc.cases.services import record_event
-
-    waiting = net.waiting_messages(Marking(case.marking))
-    if not waiting:
-        return False
-    names = {config.name for _, config in waiting}
-    messages = Message.objects.select_for_update(skip_locked=True).filter(
-        organisation_id=case.organisation_id, name__in=names,
-        consumed_at__isnull=True, expires_at__gt=timezone.now(),
-    )  # fmt: skip
-    if only is not None:
-        messages = messages.filter(pk=only)
-    for message in messages.order_by("received_at", "id")[:100]:
-        for transition, config in waiting:
-            if config.name == message.name and correlates(config, case.data, message.correlation):
-                before = Marking(case.marking)
-                after = net.receive(before, transition)
-                case.marking = dict(after)
-                case.data = {**case.data, **message.payload}
-                message.case, message.transition = case, transition
-                message.consumed_at = timezone.now()
-                message.save(update_fields=["case", "transition", "consumed_at"])
-                record_event(
-                    case, EventType.MESSAGE_RECEIVED, task=transition, before=before, after=after,
-                    detail={"message": message.message_id, "name": message.name},
-                )  # fmt: skip
-                return True
-    return False
 
 
 def purge_expired_messages() -> int:

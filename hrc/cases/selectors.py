@@ -76,7 +76,7 @@ def performable_by(user: AnyUser) -> Q:
     """Operator work items offered to `user`: as a candidate or as a member of the item's team.
 
     Subqueries, not joins, so the rows stay one per item without DISTINCT; the
-    rule the work item services enforce (services._locked_item).
+    rule the work item services enforce (progress.lock_operator_item).
     """
     if not user.is_authenticated:
         return Q(pk__in=[])

@@ -1,36 +1,38 @@
 """Celery tasks of the cases app: thin, idempotent, ids only; the logic is in jobs.py.
 
 A task may run twice (a redelivery, the sweeper ringing again): each one
-re-reads the rows and does nothing when there is nothing to do.
+re-reads the rows and does nothing when there is nothing to do. Each is
+registered under its dispatch.Task name, which is how the cases app sends it.
 """
 
 from celery import shared_task
 
 from hrc.cases import interruptions, jobs
+from hrc.cases.dispatch import Task
 from hrc.cases.messages import purge_expired_messages
 
 
-@shared_task(ignore_result=True)
+@shared_task(name=Task.RUN_JOB.value, ignore_result=True)
 def run_job(job_id: int) -> None:
     """Rings a cobot's doorbell: runs its next job that may run (not necessarily `job_id`)."""
     jobs.run_next_job(job_id)
 
 
-@shared_task(ignore_result=True)
+@shared_task(name=Task.SWEEP.value, ignore_result=True)
 def sweep() -> dict[str, int]:
     return jobs.sweep()
 
 
-@shared_task(ignore_result=True)
+@shared_task(name=Task.INTERRUPT_COBOT.value, ignore_result=True)
 def interrupt_cobot(interruption_id: int) -> None:
     interruptions.interrupt_cobot(interruption_id)
 
 
-@shared_task(ignore_result=True)
+@shared_task(name=Task.RESUME_COBOT.value, ignore_result=True)
 def resume_cobot(interruption_id: int) -> None:
     interruptions.resume_cobot(interruption_id)
 
 
-@shared_task(ignore_result=True)
+@shared_task(name=Task.PURGE_MESSAGES.value, ignore_result=True)
 def purge_messages() -> int:
     return purge_expired_messages()

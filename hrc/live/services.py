@@ -25,6 +25,7 @@ from django.utils import timezone
 
 from hrc.cases import dispatch
 from hrc.cases.choices import JobState
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
 from hrc.cobots import urua
 from hrc.cobots.drivers.base import DriverError
@@ -108,7 +109,7 @@ def resume_cell(organisation: Organisation, cell: str, *, by: User, confirmed: b
                 .first()
             )
             if first is not None:
-                dispatch.send_on_commit("run_job", first)  # the queue waited for the resume
+                dispatch.send_on_commit(Task.RUN_JOB, first)  # the queue waited for the resume
     problems = _command_all(held, _restart)
     stop.problems = {**stop.problems, **problems}
     stop.save(update_fields=["problems"])

@@ -1,0 +1,472 @@
+"""The engine's firing rule applied to a case's rows: what happens once a command is allowed.
+
+Advancing (silent transitions, buffered messages, held completions), offering
+and withdrawing work items, starting and completing tasks (an operator's and a
+cobot's), queueing jobs, space constraints' interruptions, and the end of a
+case. Each function expects the case row lock held (lock_case and
+lock_operator_item take it) and leaves saving the case to its caller: the public
+commands (services.py) and the workers (jobs.py, messages.py) lock and check
+first. Lock order, everywhere: cobot row, then case row, then job row, then
+interruption row.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from django.contrib.auth.models import User
+from django.db.models import Exists, OuterRef, Q, Subquery
+from django.utils import timezone
+
+from hrc.cases import dispatch
+from hrc.cases.choices import (
+    OPEN_CASE_STATUSES,
+    OPEN_WORK_ITEM_STATES,
+    CaseStatus,
+    EventType,
+    IncidentKind,
+    JobState,
+    Resolution,
+    WorkItemKind,
+    WorkItemState,
+)
+from hrc.cases.dispatch import Task
+from hrc.cases.errors import Conflict, Invalid, NotAllowed, NotFound
+from hrc.cases.events import open_incident, record_event
+from hrc.cases.models import Case, Incident, Interruption, Job, Message, WorkItem
+from hrc.cases.selectors import performable_by
+from hrc.engine.commands import cobot_command
+from hrc.engine.petri import Marking
+from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, correlates
+from hrc.engine.taskconfig import TaskConfig
+
+# advance() repeats settle → messages → held completions until nothing changes;
+# each round consumes a token or a message, so a sound net stops long before this.
+MAX_ROUNDS = 10_000
+
+
+# The locks every writer takes first -------------------------------------------------
+
+
+def lock_case(case_id: int) -> Case:
+    """The case, its row locked until the transaction ends (its version read along, not locked)."""
+    return (
+        Case.objects.select_for_update(of=("self",), no_key=True)
+        .select_related("version")
+        .get(pk=case_id)
+    )
+
+
+def lock_operator_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
+    """The case (locked) and a fresh copy of an operator work item the user may perform,
+    the case and the user it is claimed by attached.
+
+    The case is found through the item and the user's memberships in the statement
+    that locks it: the organisations' wall costs the API's request no read of its own.
+    """
+    item_id = item.pk if isinstance(item, WorkItem) else item
+    case = (
+        Case.objects.select_for_update(of=("self",), no_key=True)
+        .select_related("version")
+        .filter(
+            pk=Subquery(WorkItem.objects.filter(pk=item_id).values("case_id")),
+            organisation__memberships__user_id=user.pk,
+            organisation__memberships__is_active=True,  # deactivated there: not theirs to do
+        )
+        .first()
+    )
+    if case is None:
+        raise NotFound(f"There is no work item {item_id} in your organisations.")
+    offered = WorkItem.objects.filter(
+        performable_by(user),
+        pk=OuterRef("pk"),
+        case__organisation__memberships__user_id=user.pk,
+        case__organisation__memberships__is_active=True,
+    )  # a candidate (or in the item's team) and still a member; read with the item in one query
+    item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item_id)
+    check_operator_task(item)
+    if not item.performable:
+        raise NotAllowed(f"{item.label} is not offered to you.")
+    # What the caller hands back (the API's answer) reads these; they are in hand.
+    item.case = case
+    if item.claimed_by_id == user.pk:
+        item.claimed_by = user
+    return case, item
+
+
+def check_operator_task(item: WorkItem) -> None:
+    """Conflict unless the work item is an operator's (a cobot's is the workers' to drive)."""
+    if item.kind != WorkItemKind.OPERATOR:
+        raise Conflict(f"{item.label} is done by a cobot, not by an operator.")
+
+
+# The firing rule on the rows ---------------------------------------------------------
+
+
+def advance(case: Case, net: CaseNet) -> None:
+    """Fires what fires by itself and brings the work items in line with the marking.
+
+    Silent transitions fire, buffered messages are taken, cobot tasks whose
+    step is done complete once their func constraints allow; then the case
+    completes, or tasks that became startable are offered and those that
+    stopped being startable are withdrawn. Call while holding the case row
+    lock; the caller saves the case.
+    """
+    if case.status not in OPEN_CASE_STATUSES:
+        return
+    try:
+        for _ in range(MAX_ROUNDS):
+            fired = _settle(case, net)
+            taken = take_buffered_message(case, net)
+            held = _complete_held_steps(case, net)
+            if not (fired or taken or held):
+                break
+    except RuntimeFault as fault:
+        fail_case(case, str(fault))
+        return
+    marking = Marking(case.marking)
+    if net.is_final(marking):
+        end_case(case, CaseStatus.COMPLETED, EventType.CASE_COMPLETED, None, {})
+        return
+    if case.status == CaseStatus.RUNNING:
+        _offer_and_withdraw(case, net, marking)
+
+
+def _settle(case: Case, net: CaseNet) -> bool:
+    before = Marking(case.marking)
+    after, fired = net.settle(before, case.data)
+    marking = before
+    for transition in fired:
+        after_one = net.transition(transition).fire(marking)
+        record_event(
+            case, EventType.TRANSITION_FIRED, task=transition, before=marking, after=after_one
+        )
+        marking = after_one
+    case.marking = dict(after)
+    return bool(fired)
+
+
+def _complete_held_steps(case: Case, net: CaseNet) -> bool:
+    """Completes cobot tasks whose step is done and whose func constraints now allow it."""
+    if not net.holdable_tasks:
+        return False  # no constraint can hold a completion: nothing is ever held
+    done = False
+    undecided = Incident.objects.filter(work_item=OuterRef("pk"), resolved_at__isnull=True)
+    held = (
+        WorkItem.objects.filter(
+            case=case, task__in=net.holdable_tasks, state=WorkItemState.RUNNING,
+            job__state=JobState.SUCCEEDED,
+        )
+        .exclude(Exists(undecided))  # outputs that did not map wait for a person
+        .select_related("job")
+    )  # fmt: skip
+    for item in held:
+        if net.can_complete(Marking(case.marking), item.task):
+            done = _complete_step(case, net, item, item.job.result or {}) or done
+            # Completed, or an incident that its outputs did not map: it holds the cobot no more.
+            _end_hold(item.job)
+    return done
+
+
+def _offer_and_withdraw(case: Case, net: CaseNet, marking: Marking) -> None:
+    startable = set(net.startable(marking))
+    open_items = {
+        item.task: item
+        for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES)
+    }
+    for task, item in open_items.items():
+        if item.state != WorkItemState.RUNNING and task not in startable:
+            _withdraw(case, item, "another task took its turn")
+    for task in net.startable(marking):
+        if task not in open_items:
+            _offer(case, net, task)
+    if not startable and not open_items and not net.waiting_messages(marking):
+        fail_case(
+            case,
+            f"The case cannot go on: nothing can start in marking {dict(marking)} "
+            "(a guard that holds for no branch?).",
+        )
+
+
+def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
+    config = net.tasks[task]
+    actor = net.performers[task]
+    binding = case.actor_mapping[actor]
+    item = WorkItem.objects.create(
+        case=case, task=task, label=net.labels[task], actor=actor,
+        kind=config.kind, instructions=config.instructions,
+        team_id=binding.get("team"), cobot_id=binding.get("cobot"),
+    )  # fmt: skip
+    if config.kind == "operator":
+        # A new item has no candidates yet: insert them in one statement.
+        Candidate = WorkItem.candidates.through
+        Candidate.objects.bulk_create(
+            Candidate(workitem_id=item.pk, user_id=user_id) for user_id in binding.get("users", ())
+        )
+    else:
+        _queue_job(case, net, item, config)
+    record_event(case, EventType.TASK_OFFERED, item=item)
+    return item
+
+
+def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> None:
+    assert item.cobot_id is not None  # a cobot task's actor maps to a cobot (mapping.py)
+    now = timezone.now()
+    job = Job(
+        work_item=item, case=case, cobot_id=item.cobot_id, kind=config.kind,
+        timeout=config.timeout, retries_left=config.retries, next_try_at=now, command={},
+    )  # fmt: skip
+    try:
+        job.command = cobot_command(item.task, config, case.data)
+    except RuntimeFault as fault:
+        job.state, job.last_error = JobState.FAILED, str(fault)
+        job.save()
+        open_incident(case, IncidentKind.CASE_FAULT, str(fault), item=item)
+        return
+    job.save()
+    dispatch.send_on_commit(Task.RUN_JOB, job.pk)
+
+
+def _withdraw(case: Case, item: WorkItem, why: str) -> None:
+    if item.state == WorkItemState.RUNNING and item.kind != WorkItemKind.OPERATOR:
+        held = Job.objects.filter(work_item=item, state=JobState.SUCCEEDED).first()
+        if held is not None:  # the case ends while its func constraint holds the cobot
+            _end_hold(held)
+    item.state, item.ended_at = WorkItemState.WITHDRAWN, timezone.now()
+    item.save(update_fields=["state", "ended_at"])
+    Job.objects.filter(work_item=item, state__in=[JobState.QUEUED, JobState.FAILED]).update(
+        state=JobState.CANCELLED, ended_at=item.ended_at
+    )
+    Incident.objects.filter(work_item=item, resolved_at__isnull=True).update(
+        resolved_at=item.ended_at, resolution=Resolution.CANCEL
+    )
+    record_event(case, EventType.TASK_WITHDRAWN, item=item, detail={"why": why})
+
+
+def start_task(case: Case, net: CaseNet, item: WorkItem, user: User | None) -> None:
+    """Fires the task's start; interrupts the cobots it shares a space with. Raises NotEnabled."""
+    before = Marking(case.marking)
+    after = net.start(before, item.task)
+    case.marking = dict(after)
+    item.state, item.started_at = WorkItemState.RUNNING, timezone.now()
+    record_event(case, EventType.TASK_STARTED, item=item, user=user, before=before, after=after)
+    if item.kind == WorkItemKind.OPERATOR:
+        _interrupt_shared_space(case, net, item)
+
+
+def complete_task(
+    case: Case,
+    net: CaseNet,
+    item: WorkItem,
+    result: Mapping[str, Any],
+    user: User | None,
+) -> None:
+    """Fires the task's completion and maps its outputs into the case data. Raises NotEnabled."""
+    before = Marking(case.marking)
+    after = net.complete(before, item.task)
+    try:
+        case.data = apply_outputs(net.tasks[item.task], item.task, result, case.data)
+    except RuntimeFault as fault:
+        raise Invalid(str(fault)) from None
+    case.marking = dict(after)
+    item.state, item.ended_at = WorkItemState.COMPLETED, timezone.now()
+    item.result, item.completed_by = dict(result), user
+    item.save(update_fields=["state", "ended_at", "result", "completed_by", "started_at"])
+    record_event(case, EventType.TASK_COMPLETED, item=item, user=user, before=before, after=after)
+    if item.task in net.space_tasks:  # only a space constraint's tasks are ever interrupted
+        _end_interruptions(case, Q(work_item=item) | Q(operator_work_item=item))
+
+
+def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
+    """Starts a cobot task as its cobot takes the job (jobs.lease_next_job).
+
+    Call while holding the case row lock, with the start enabled; the caller saves the case.
+    """
+    start_task(case, net, item, None)
+    item.save(update_fields=["state", "started_at"])
+    advance(case, net)
+
+
+def complete_cobot_task(
+    case: Case, net: CaseNet, item: WorkItem, result: Mapping[str, Any]
+) -> None:
+    """Completes a cobot task whose step is done, unless a func constraint still holds it
+    (then `advance` completes it once the constraint allows).
+
+    Call while holding the case row lock, with the item running; the caller saves the case.
+    """
+    if net.can_complete(Marking(case.marking), item.task):
+        _complete_step(case, net, item, result)
+    advance(case, net)
+
+
+def _complete_step(case: Case, net: CaseNet, item: WorkItem, result: Mapping[str, Any]) -> bool:
+    """Completes a cobot task whose step is done; an incident when its outputs do not map.
+
+    The step ran and is not sent again: a person skips the task with the
+    outputs it should have given, or cancels the case.
+    """
+    try:
+        complete_task(case, net, item, result, None)
+    except Invalid as fault:
+        open_incident(
+            case, IncidentKind.CASE_FAULT,
+            f"{item.label} ran, but its outputs cannot go into the case data: {fault}", item=item,
+        )  # fmt: skip
+        return False
+    return True
+
+
+# Messages, interruptions, doorbells -----------------------------------------------------
+
+
+def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> bool:
+    """Fires a waiting message transition with the oldest matching unexpired message, if any.
+
+    Call while holding the case row lock. Returns whether a message was taken.
+    """
+    waiting = net.waiting_messages(Marking(case.marking))
+    if not waiting:
+        return False
+    names = {config.name for _, config in waiting}
+    messages = Message.objects.select_for_update(skip_locked=True).filter(
+        organisation_id=case.organisation_id, name__in=names,
+        consumed_at__isnull=True, expires_at__gt=timezone.now(),
+    )  # fmt: skip
+    if only is not None:
+        messages = messages.filter(pk=only)
+    for message in messages.order_by("received_at", "id")[:100]:
+        for transition, config in waiting:
+            if config.name == message.name and correlates(config, case.data, message.correlation):
+                before = Marking(case.marking)
+                after = net.receive(before, transition)
+                case.marking = dict(after)
+                case.data = {**case.data, **message.payload}
+                message.case, message.transition = case, transition
+                message.consumed_at = timezone.now()
+                message.save(update_fields=["case", "transition", "consumed_at"])
+                record_event(
+                    case, EventType.MESSAGE_RECEIVED, task=transition, before=before, after=after,
+                    detail={"message": message.message_id, "name": message.name},
+                )  # fmt: skip
+                return True
+    return False
+
+
+def _interrupt_shared_space(case: Case, net: CaseNet, operator_item: WorkItem) -> None:
+    for pair in net.space_pairs:
+        if pair.operator_task != operator_item.task:
+            continue
+        cobot_item = WorkItem.objects.filter(
+            case=case, task=pair.cobot_task, state=WorkItemState.RUNNING
+        ).first()
+        if cobot_item is None or cobot_item.cobot_id is None:
+            continue  # not running: the cobot's job waits for the operator instead (jobs.py)
+        interruption = Interruption.objects.create(
+            case=case, work_item=cobot_item, operator_work_item=operator_item,
+            cobot_id=cobot_item.cobot_id, mode=pair.mode,
+        )  # fmt: skip
+        record_event(case, EventType.TASK_INTERRUPTED, item=cobot_item,
+                detail={"interruption": interruption.pk, "by": operator_item.task, "mode": pair.mode})  # fmt: skip
+        dispatch.send_on_commit(Task.INTERRUPT_COBOT, interruption.pk)
+
+
+def _end_interruptions(case: Case, which: Q) -> None:
+    for interruption in Interruption.objects.filter(which, case=case, ended_at__isnull=True):
+        interruption.ended_at = timezone.now()
+        interruption.save(update_fields=["ended_at"])
+        seconds = (interruption.ended_at - interruption.started_at).total_seconds()
+        record_event(case, EventType.TASK_RESUMED, item=interruption.work_item,
+                detail={"interruption": interruption.pk, "seconds": round(seconds, 3)})  # fmt: skip
+        dispatch.send_on_commit(Task.RESUME_COBOT, interruption.pk)
+
+
+def _end_hold(job: Job) -> None:
+    """The cobot a func hold reserved for this case is free once this transaction commits: its
+    next job goes now, not at the next sweep. Held items end only by completing (advance's
+    held completions, which a skip or a message reaches too) or by withdrawal (the case ends)."""
+    ring_for_next_job_on_commit(job.pk, job.cobot_id)
+
+
+def ring_for_next_job_on_commit(job_id: int, cobot_id: int) -> None:
+    """Rings the doorbell of `job_id`'s cobot once this transaction has committed, if a job is
+    queued for the cobot then: most often none is, and a doorbell would cost a task and a
+    transaction to find nothing. Asked after the commit, so none is missed: a job queued
+    meanwhile rang its own doorbell, which found the cobot busy, after it had committed."""
+
+    def queued() -> bool:
+        return Job.objects.filter(cobot_id=cobot_id, state=JobState.QUEUED).exists()
+
+    dispatch.send_on_commit_if(queued, Task.RUN_JOB, job_id)
+
+
+def ring_for_queued_jobs_on_commit(case: Case) -> None:
+    """Rings the doorbell of each cobot the case has queued work for."""
+    for job_id in Job.objects.filter(case=case, state=JobState.QUEUED).values_list("pk", flat=True):
+        dispatch.send_on_commit(Task.RUN_JOB, job_id)
+
+
+# Incidents resolved, and case endings --------------------------------------------------
+
+
+def retry_job(case: Case, net: CaseNet, item: WorkItem, again: bool) -> None:
+    """Queues the item's job again with its retries restored; `again` gives the step a new
+    token, so a step that ran once runs once more. Conflict when there is no job or it runs."""
+    job = Job.objects.select_for_update().filter(work_item=item).first()
+    if job is None:
+        raise Conflict(f"{item.label} is an operator task: there is nothing to retry.")
+    if job.state == JobState.RUNNING:
+        raise Conflict(f"{item.label} is running again already.")
+    command = (
+        cobot_command(item.task, net.tasks[item.task], case.data)
+        if job.state == JobState.FAILED and not job.command
+        else job.command
+    )
+    job.command = command
+    job.state, job.retries_left, job.lease_expiries = (
+        JobState.QUEUED,
+        net.tasks[item.task].retries,
+        0,
+    )
+    job.next_try_at, job.last_error = timezone.now(), ""
+    if again:
+        job.attempt += 1
+    job.save()
+    dispatch.send_on_commit(Task.RUN_JOB, job.pk)
+
+
+def skip_task(case: Case, net: CaseNet, item: WorkItem, outputs: dict[str, Any], by: User) -> None:
+    """Completes the item with `outputs` as if its step had given them (starting it first when it
+    has not started); its unfinished jobs are cancelled. Conflict when the marking forbids it."""
+    Job.objects.filter(work_item=item).exclude(state=JobState.SUCCEEDED).update(
+        state=JobState.CANCELLED, ended_at=timezone.now()
+    )
+    if item.state != WorkItemState.RUNNING:
+        try:
+            start_task(case, net, item, by)
+        except NotEnabled as refused:
+            raise Conflict(f"{item.label} cannot be skipped now: {refused}") from None
+    try:
+        complete_task(case, net, item, outputs, by)
+    except NotEnabled as refused:
+        raise Conflict(f"{item.label} cannot be skipped now: {refused}") from None
+    advance(case, net)
+
+
+def end_case(case: Case, status: str, event: str, by: User | None, detail: dict[str, Any]) -> None:
+    """Ends the case with `status`: open work is withdrawn, its interruptions end."""
+    for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES):
+        _withdraw(case, item, f"the case is {status}")
+    _end_interruptions(case, Q())
+    case.status, case.ended_at = status, timezone.now()
+    record_event(case, event, user=by, detail=detail)
+
+
+def end_as_cancelled(case: Case, by: User | None, detail: dict[str, Any]) -> None:
+    end_case(case, CaseStatus.CANCELLED, EventType.CASE_CANCELLED, by, detail)
+
+
+def fail_case(case: Case, message: str) -> None:
+    open_incident(case, IncidentKind.CASE_FAULT, message)
+    end_case(case, CaseStatus.FAILED, EventType.CASE_FAILED, None, {"message": message})
