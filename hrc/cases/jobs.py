@@ -59,7 +59,7 @@ from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet
-from hrc.live import broadcast as live
+from hrc.live import groups as live
 
 logger = logging.getLogger(__name__)
 
@@ -87,7 +87,7 @@ class Lease:
 def run_next_job(job_id: int) -> None:
     """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
-    # started, the queue) waits until the cobot has accepted the step (hrc/live/broadcast.py).
+    # started, the queue) waits until the cobot has accepted the step (hrc/live/sender.py).
     hold = live.hold()
     # When the cobot accepted the step: its work starts there, not at the lease (analytics).
     accepted: list[dt.datetime] = []
@@ -143,7 +143,7 @@ def _lease_next(which: Q) -> Lease | None:
         cobot = Cobot.objects.select_for_update(of=("self",), no_key=True).filter(which).first()
         if cobot is None:
             return None
-        if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.live.services)
+        if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.cobots.stops)
             return None
         # The queue, with the reasons the whole cobot waits (a job running, a pause for an
         # operator in a shared area) on each row: a second statement, so they are fresh.

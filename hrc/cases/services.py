@@ -42,7 +42,7 @@ from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, resolve
 from hrc.engine.startdata import check_start_data
 from hrc.engine.taskconfig import POSE_LENGTH, TaskConfig
-from hrc.live import broadcast as live
+from hrc.live import groups as live
 from hrc.patterns.models import PatternVersion
 
 # A start form's "count": enough for a shift's batch, not a load test by accident.

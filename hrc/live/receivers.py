@@ -1,7 +1,12 @@
 """The live app's answers to the inner apps' hooks, registered when Django is ready (apps.py)."""
 
-from hrc.live import broadcast
+from hrc.cobots import hooks as cobot_hooks
+from hrc.live import groups
 from hrc.organisations import hooks as organisation_hooks
 
 # An admin who ends a membership closes that person's sockets at once.
-organisation_hooks.register_membership_ended(broadcast.membership_ended_on_commit)
+organisation_hooks.register_membership_ended(groups.membership_ended_on_commit)
+# A STOP and the queues it holds or releases show on the tablets.
+cobot_hooks.register_tablets(
+    queue_changed=groups.cobot_queue_on_commit, stop_changed=groups.cell_stop_on_commit
+)
