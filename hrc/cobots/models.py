@@ -3,7 +3,8 @@
 A gateway endpoint belongs to one cobot of one organisation (`endpoint_key`,
 unique), and a cobot's credentials are a named secret of its own
 organisation (CredentialsSecret, encrypted at rest), so no organisation can
-reach another's robot by its address or its credentials.
+reach another's robot by its address or its credentials. CellStop records
+each STOP a tablet gave (hrc.cobots.stops).
 """
 
 from django.conf import settings
