@@ -102,8 +102,8 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
     # The channel layer's messages -------------------------------------------------------
 
     async def live_events(self, message: dict[str, Any]) -> None:
-        """The deltas of one commit, in one frame (the sender's encoding, when it is all):
-        those for this socket's cell go out now, cobot states coalesced (on_cobot_state)."""
+        """The deltas of one commit: those for this socket's cell go out now, in one frame (the
+        sender's own encoding when none was left out); cobot states wait (on_cobot_state)."""
         events = message["events"]
         if not self._organisation_matches(message):
             return
