@@ -346,7 +346,7 @@ def measure_floor(bench: Rig, settings: Settings) -> dict[str, Any]:
     """A bare group_send of one delta to the organisation's group, until every tablet has it."""
     from channels.layers import get_channel_layer
 
-    from hrc.live import broadcast
+    from hrc.live import groups, sender
     from hrc.live.events import CaseDelta
 
     layer = get_channel_layer()
@@ -360,8 +360,8 @@ def measure_floor(bench: Rig, settings: Settings) -> dict[str, Any]:
                 "type": "case", "case": marker, "seq": 1, "event": "case-started",
                 "data": {"id": marker, "seq": 1, "status": "running", "name": "", "cobots": []},
             }  # fmt: skip
-            group = broadcast.organisation_group(organisation)
-            message = broadcast._Send([group], organisation, [delta], [""]).message()
+            group = groups.organisation_group(organisation)
+            message = sender.Send([group], organisation, [delta], [""]).message()
             bench.tablets.expect(_is_case(marker))
             sent = time.perf_counter()
             loop.run_until_complete(layer.group_send(group, message))

@@ -14,6 +14,10 @@ import asyncio
 import logging
 from typing import Any
 
+from hrc.cases import dispatch
+from hrc.live import groups
+from hrc.live.monitor import Monitor
+
 logger = logging.getLogger(__name__)
 
 Scope = dict[str, Any]
@@ -34,13 +38,9 @@ class EmbeddedServices:
 
 def start(loop: asyncio.AbstractEventLoop) -> asyncio.Task[None]:
     """Starts the sweeper (once per process) and the cobot monitor on `loop`; returns the monitor."""
-    from hrc.cases import dispatch
-    from hrc.live import broadcast
-    from hrc.live.monitor import Monitor
-
     dispatch.start_embedded_sweeper()
     # Broadcasts from job threads reach the in-memory layer only through this loop.
-    broadcast.server_loop = loop
+    groups.serve_from(loop)
     task = loop.create_task(Monitor().run(), name="hrc-embedded-monitor")
     task.add_done_callback(_report_end)
     logger.info("Embedded sweeper and cobot monitor started")

@@ -1,19 +1,20 @@
 """A space constraint's interruption, on the cobot: pause (or slow) it, and resume it after.
 
 The rows (who interrupted whom, when it ended) are written by the case
-services; these commands follow on the workers, each sent by one sender only,
-and what the cobot refused is kept on the interruption for the sweeper.
+services; these commands follow on the workers. Each command is claimed in a
+committed conditional update (Interruption.claimed_at), sent outside any
+transaction (hrc.cobots.commands), and its outcome recorded in a short
+transaction: it is never sent twice, no lock waits on the robot, and what the
+cobot refused is kept on the interruption for the sweeper to send again.
 """
 
 from __future__ import annotations
 
-import threading
-from collections import defaultdict
-from collections.abc import Iterator
-from contextlib import contextmanager
+import datetime as dt
+from typing import Final
 
-from django.conf import settings
-from django.db import connection, transaction
+from django.db import transaction
+from django.db.models import Q, QuerySet
 from django.utils import timezone
 
 from hrc.cases import dispatch
@@ -21,67 +22,30 @@ from hrc.cases.choices import JobState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
 from hrc.cobots import urua
+from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
 
 SLOW_OVERRIDE_PERCENT = 10.0
 FULL_OVERRIDE_PERCENT = 100.0
-
-
-def _locked_interruption(interruption_id: int) -> Interruption:
-    return (
-        Interruption.objects.select_for_update(of=("self",))
-        .select_related("cobot")
-        .get(pk=interruption_id)
-    )
-
-
-# The embedded default's senders of one interruption's commands, all threads of one process.
-_embedded_senders: defaultdict[int, threading.Lock] = defaultdict(threading.Lock)
-
-
-@contextmanager
-def _sole_sender(interruption_id: int) -> Iterator[Interruption]:
-    """The interruption, read by the only thread that may command its cobot for it until exit.
-
-    On PostgreSQL its row lock, held across the cobot call, blocks only that row. The
-    embedded SQLite has one write lock for the whole database, taken at BEGIN: held
-    across a call to an unreachable cobot it would stall every writer for the connect
-    timeout. There (no Redis: one process) a lock per interruption serialises the
-    senders instead, and each write is a short transaction of its own.
-    """
-    if connection.vendor == "sqlite" and not settings.REDIS_URL:
-        with _embedded_senders[interruption_id]:
-            yield Interruption.objects.select_related("cobot").get(pk=interruption_id)
-        return
-    with transaction.atomic():
-        yield _locked_interruption(interruption_id)
-
-
-def _command(interruption: Interruption, *, pause: bool) -> bool:
-    """Pauses or resumes (slows or restores the speed of) the cobot; records why when it cannot."""
-    driver = driver_for_cobot(interruption.cobot)
-    try:
-        if interruption.mode == "slow":
-            speed = SLOW_OVERRIDE_PERCENT if pause else FULL_OVERRIDE_PERCENT
-            driver.write({urua.STATE_OVERRIDE: speed})
-        else:
-            driver.call("PauseProgram" if pause else "StartProgram")
-    except DriverError as error:
-        interruption.error = f"{'pause' if pause else 'resume'}: {error}"
-        interruption.save(update_fields=["error"])
-        return False
-    return True
+# A claim this old died with its sender (a cobot answers or times out well before): free again.
+CLAIM_EXPIRES: Final = dt.timedelta(minutes=2)
 
 
 def interrupt_cobot(interruption_id: int) -> None:
     """Pauses (or slows) the cobot for an interruption still open; never twice."""
-    with _sole_sender(interruption_id) as interruption:
-        if interruption.ended_at is not None or interruption.paused_at is not None:
+    claimed = _claim(interruption_id, Q(ended_at__isnull=True, paused_at__isnull=True))
+    if claimed is None:
+        return
+    error = _command(claimed, pause=True)
+    with transaction.atomic():
+        if error:
+            _record(claimed, error=f"pause: {error}")
             return
-        if _command(interruption, pause=True):
-            interruption.paused_at = timezone.now()
-            interruption.save(update_fields=["paused_at"])
+        _record(claimed, paused_at=timezone.now())
+        if Interruption.objects.filter(pk=claimed.pk, ended_at__isnull=False).exists():
+            # It ended while the pause was on its way: that resume found the claim taken.
+            dispatch.send_on_commit(Task.RESUME_COBOT, claimed.pk)
 
 
 def resume_cobot(interruption_id: int) -> None:
@@ -89,27 +53,79 @@ def resume_cobot(interruption_id: int) -> None:
 
     A resume that fails is left for the sweeper, which sends it again until it succeeds.
     """
-    with _sole_sender(interruption_id) as interruption:
-        if interruption.ended_at is None or interruption.resumed_at is not None:
+    claimed = _claim(interruption_id, Q(ended_at__isnull=False, resumed_at__isnull=True))
+    if claimed is None:
+        return
+    others = Interruption.objects.filter(
+        cobot=claimed.cobot, ended_at__isnull=True, paused_at__isnull=False
+    ).exclude(pk=claimed.pk)
+    needed = claimed.paused_at is not None and not others.exists()
+    needed = needed and claimed.cobot.stopped_at is None  # a STOP's resume restarts it
+    error = _command(claimed, pause=False) if needed else ""
+    with transaction.atomic():
+        if error:
+            _record(claimed, error=f"resume: {error}")
             return
-        others = Interruption.objects.filter(
-            cobot=interruption.cobot, ended_at__isnull=True, paused_at__isnull=False
-        ).exclude(pk=interruption.pk)
-        needed = interruption.paused_at is not None and not others.exists()
-        needed = needed and interruption.cobot.stopped_at is None  # a STOP's resume restarts it
-        if needed and not _command(interruption, pause=False):
-            return
-        interruption.resumed_at = timezone.now()
-        interruption.save(update_fields=["resumed_at"])
-    # The cobot's queue waited for this interruption to settle.
+        _record(claimed, resumed_at=timezone.now())
+        ring_next_job_on_commit(claimed.cobot_id)  # the queue waited for this to settle
+
+
+def _claim(interruption_id: int, due: Q) -> Interruption | None:
+    """The interruption, once this sender alone may command its cobot for it; None when it is
+    not `due`, or another sender holds it."""
+    now = timezone.now()
+    free = Q(claimed_at__isnull=True) | Q(claimed_at__lt=now - CLAIM_EXPIRES)
+    with transaction.atomic():
+        won = Interruption.objects.filter(due, free, pk=interruption_id).update(claimed_at=now)
+    if not won:
+        return None
+    return Interruption.objects.select_related("cobot").get(pk=interruption_id)
+
+
+def _record(interruption: Interruption, **outcome: object) -> None:
+    """Writes the outcome and gives the claim back; call inside the recording transaction."""
+    Interruption.objects.filter(pk=interruption.pk).update(claimed_at=None, **outcome)
+
+
+def _command(interruption: Interruption, *, pause: bool) -> str:
+    """Pauses or resumes (slows or restores the speed of) the cobot; "" when done, else why not."""
+
+    def send() -> None:
+        driver = driver_for_cobot(interruption.cobot)
+        if interruption.mode == "slow":
+            speed = SLOW_OVERRIDE_PERCENT if pause else FULL_OVERRIDE_PERCENT
+            driver.write({urua.STATE_OVERRIDE: speed})
+        else:
+            driver.call("PauseProgram" if pause else "StartProgram")
+
+    try:
+        outside_transaction(send)
+    except DriverError as error:
+        return str(error)
+    return ""
+
+
+def ring_next_job_on_commit(cobot_id: int) -> None:
+    """Starts the cobot's first queued job once the transaction commits, if one waits."""
     job_id = (
-        Job.objects.filter(cobot=interruption.cobot, state=JobState.QUEUED)
+        Job.objects.filter(cobot_id=cobot_id, state=JobState.QUEUED)
         .values_list("pk", flat=True)
         .first()
     )
     if job_id is not None:
-        with transaction.atomic():
-            dispatch.send_on_commit(Task.RUN_JOB, job_id)
+        dispatch.send_on_commit(Task.RUN_JOB, job_id)
+
+
+def holding(cobot_id: int) -> QuerySet[Interruption]:
+    """The interruptions that keep the cobot paused or slowed."""
+    return Interruption.objects.filter(cobot_id=cobot_id).filter(
+        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
+    )
+
+
+def holds_cobot(cobot_id: int) -> bool:
+    """Whether an operator's interruption still keeps the cobot paused (a STOP's resume asks)."""
+    return holding(cobot_id).exists()
 
 
 def to_redo() -> list[tuple[Task, int]]:

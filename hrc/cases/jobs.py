@@ -143,7 +143,7 @@ def _lease_next(which: Q) -> Lease | None:
         cobot = Cobot.objects.select_for_update(of=("self",), no_key=True).filter(which).first()
         if cobot is None:
             return None
-        if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.live.services)
+        if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.cobots.stops)
             return None
         # The queue, with the reasons the whole cobot waits (a job running, a pause for an
         # operator in a shared area) on each row: a second statement, so they are fresh.

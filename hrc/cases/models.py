@@ -173,8 +173,9 @@ class Job(models.Model):
 class Interruption(models.Model):
     """A cobot task paused or slowed while an operator works in a shared area (space constraint).
 
-    The pause and the resume are each sent at most once, by tasks that lock
-    this row; a resume that finds no pause sent marks it never needed.
+    The pause and the resume are each sent at most once, by the task that claimed
+    the row (claimed_at) and sends outside any transaction (hrc.cases.interruptions);
+    a resume that finds no pause sent marks it never needed.
     """
 
     case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="interruptions")
@@ -187,6 +188,9 @@ class Interruption(models.Model):
     paused_at = models.DateTimeField(null=True, blank=True)
     resumed_at = models.DateTimeField(null=True, blank=True)
     error = models.TextField(blank=True)
+    claimed_at = models.DateTimeField(
+        null=True, blank=True, help_text="Set while one sender sends its pause or resume."
+    )
 
     class Meta:
         ordering = ["started_at", "id"]

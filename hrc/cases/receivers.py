@@ -3,13 +3,18 @@
 # The tasks, registered with the Celery app: dispatch finds them by name to run them inline.
 import hrc.cases.tasks
 import hrc.celery  # noqa: F401  (the Celery app, so tasks sent from a web process use the configured broker)
-from hrc.cases import selectors, services
+from hrc.cases import interruptions, selectors, services
 from hrc.cobots import hooks as cobot_hooks
 from hrc.organisations import hooks as organisation_hooks
 
 # The cobots app asks whether a case is using a cobot before a person's command.
 cobot_hooks.register_cobot_use(
     in_use=selectors.cobot_in_use, queue_lengths=selectors.cobot_queue_lengths
+)
+# A STOP's resume restarts no cobot an operator's interruption holds, and starts the queues.
+cobot_hooks.register_cobot_queues(
+    held_by_interruption=interruptions.holds_cobot,
+    queue_released=interruptions.ring_next_job_on_commit,
 )
 # A deactivated person's tasks go back to their candidates.
 organisation_hooks.register_member_leaving(services.hand_back_work_items)

@@ -2,8 +2,8 @@
 
 Engineers and admins of the cobot's organisation use it from the cobot's page
 and the API (the callers check the role). Each command is confirmed, recorded
-as a CobotCommand row before it goes out (who, what, when, and what came of
-it), and refused while a case is using the cobot (hrc.cobots.hooks, answered
+as a CobotCommand row committed before it goes out, outside any transaction
+(hrc.cobots.commands; who, what, when, and what came of it), and refused while a case is using the cobot (hrc.cobots.hooks, answered
 by the cases app) or while another command on it has not finished, so a
 double click never sends a command twice.
 
@@ -27,6 +27,7 @@ from django.utils import timezone
 
 from hrc.cobots import hooks, urua
 from hrc.cobots.choices import CommandOutcome, ControlCommand
+from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import (
     CobotUnreachable,
     DriverError,
@@ -98,8 +99,11 @@ def run_command(
     if not confirmed:
         raise ControlError(f"{command.label} on {cobot} needs a confirmation (confirm: true).", 400)
     record = _record(cobot, command, arguments, by)
+    method = METHODS[command]
     try:
-        _driver(cobot).call(METHODS[command], *arguments.values(), timeout=COMMAND_TIMEOUT)
+        outside_transaction(
+            lambda: _driver(cobot).call(method, *arguments.values(), timeout=COMMAND_TIMEOUT)
+        )
     except DriverError as error:
         status, outcome = _failure(error)
         _finish(record, outcome, str(error))

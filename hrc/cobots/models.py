@@ -3,7 +3,8 @@
 A gateway endpoint belongs to one cobot of one organisation (`endpoint_key`,
 unique), and a cobot's credentials are a named secret of its own
 organisation (CredentialsSecret, encrypted at rest), so no organisation can
-reach another's robot by its address or its credentials.
+reach another's robot by its address or its credentials. CellStop records
+each STOP a tablet gave (hrc.cobots.stops).
 """
 
 from django.conf import settings
@@ -79,7 +80,7 @@ class Cobot(models.Model):
         null=True,
         blank=True,
         editable=False,
-        help_text="Set while a tablet's STOP holds the cobot paused (hrc.live.services); no job starts.",
+        help_text="Set while a tablet's STOP holds the cobot paused (hrc.cobots.stops); no job starts.",
     )
     is_active = models.BooleanField(
         default=True,
@@ -275,3 +276,43 @@ class CobotCommand(models.Model):
 
     def __str__(self) -> str:
         return f"{self.get_command_display()} on {self.cobot_id} ({self.outcome})"
+
+
+class CellStop(models.Model):
+    """A tablet's STOP: every cobot of the cell paused until someone confirms resuming.
+
+    A convenience, not a safety function: the robots' own safety systems stay in
+    charge, and nothing here clears a protective or emergency stop.
+    """
+
+    organisation = models.ForeignKey(
+        Organisation, on_delete=models.CASCADE, related_name="cell_stops"
+    )
+    cell = models.CharField(max_length=50, blank=True, help_text="Empty: the whole floor.")
+    stopped_by = models.ForeignKey(
+        settings.AUTH_USER_MODEL, on_delete=models.SET_NULL, null=True, related_name="+"
+    )
+    stopped_at = models.DateTimeField(auto_now_add=True)
+    resumed_by = models.ForeignKey(
+        settings.AUTH_USER_MODEL, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    resumed_at = models.DateTimeField(null=True, blank=True)
+    cobots = models.JSONField(default=list, help_text="The ids of the cobots it paused.")
+    problems = models.JSONField(
+        default=dict, blank=True, help_text="Cobot id → why it could not be paused or resumed."
+    )
+
+    class Meta:
+        db_table = "live_cellstop"  # made by the live app, which once kept STOPs
+        ordering = ["-stopped_at", "-id"]
+        constraints = [
+            # One STOP holds a cell at a time: a second press finds the first.
+            models.UniqueConstraint(
+                fields=["organisation", "cell"],
+                condition=models.Q(resumed_at__isnull=True),
+                name="cell_stop_one_active_per_cell",
+            )
+        ]
+
+    def __str__(self) -> str:
+        return f"STOP of {self.cell or 'the floor'} at {self.stopped_at:%H:%M:%S}"

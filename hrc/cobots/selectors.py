@@ -4,6 +4,8 @@ from typing import Any
 
 from django.db.models import QuerySet
 
+from hrc.cobots.drivers.base import DriverError
+from hrc.cobots.drivers.runner import driver_for_cobot
 from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
 from hrc.organisations.selectors import AnyUser, organisations_of
 
@@ -45,10 +47,6 @@ def live_state(cobot: Cobot, *, timeout: float = 3.0) -> dict[str, Any]:
     {"reachable": False, "error": "<what went wrong>", "transient": bool};
     never raises for a cobot that cannot be reached.
     """
-    # Imported here: the driver pulls in asyncua, which pages that never ask don't need.
-    from hrc.cobots.drivers.base import DriverError
-    from hrc.cobots.drivers.runner import driver_for_cobot
-
     try:
         driver = driver_for_cobot(cobot, connect_timeout=timeout, request_timeout=timeout)
         return {"reachable": True, **driver.state()}

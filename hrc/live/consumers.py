@@ -1,12 +1,13 @@
 """The tablets' WebSocket: /ws/live/?organisation=<id>&cell=<cell>. Thin: the rules live in
-selectors (who may watch, the snapshot) and broadcast (the deltas).
+selectors (who may watch, the snapshot) and groups (the deltas).
 
 On connect: refused (a `refused` event, then close 4401/4403) unless the
 session's user is a member of the organisation, and (4404) when the cell is
 none of the organisation's; then the socket joins its
-groups and only then reads the snapshot (hrc.live.events explains why). Each
-event type has its handler; every send first re-checks that the event is the
-organisation's and the cell's, and that the user's membership still holds.
+groups and only then reads the snapshot (hrc.live.events explains why). The
+deltas pass through as they come, except the cobot states (below); every send
+first re-checks that the event is the organisation's and the cell's, and that
+the user's membership still holds.
 An admin who ends a membership closes the user's sockets at once (a
 `membership.ended` message to the user's group); as a backstop, memberships
 are read again every RECHECK_SECONDS for all the process's sockets in one
@@ -27,7 +28,7 @@ from channels.db import database_sync_to_async
 from channels.generic.websocket import AsyncJsonWebsocketConsumer
 from channels.layers import InMemoryChannelLayer
 
-from hrc.live import broadcast, selectors
+from hrc.live import groups, selectors
 from hrc.live.events import CobotStateData, LiveEvent
 from hrc.live.selectors import Access
 from hrc.organisations.validators import validate_cell
@@ -38,6 +39,8 @@ RECHECK_SECONDS = 5.0
 STATE_INTERVAL = 0.1
 # Event types about one cobot: only its cell's tablets (and the whole floor's) get them.
 CELL_SCOPED = frozenset({"cobot-state", "cobot-queue"})
+# The deltas a tablet gets as they come; `cobot-state` is coalesced; anything else is dropped.
+PASSED_ON = frozenset({"case", "work-item", "incident", "cobot-queue", "cell-stop"})
 UNAUTHENTICATED = 4401
 FORBIDDEN = 4403
 NOT_FOUND = 4404
@@ -50,7 +53,7 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
 
     async def connect(self) -> None:
         if isinstance(self.channel_layer, InMemoryChannelLayer):
-            broadcast.server_loop = asyncio.get_running_loop()  # the embedded demo's layer
+            groups.serve_from(asyncio.get_running_loop())  # the embedded demo's layer
         self.groups_joined = []
         self._states: dict[int, CobotStateData] = {}
         self._state_flush: asyncio.TimerHandle | None = None
@@ -76,9 +79,9 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             return
         MEMBERSHIPS.watch(self)
         self.groups_joined = [
-            broadcast.organisation_group(access.organisation_id),
-            broadcast.user_group(access.user_id),
-            broadcast.cell_group(access.organisation_id, self.cell),
+            groups.organisation_group(access.organisation_id),
+            groups.user_group(access.user_id),
+            groups.cell_group(access.organisation_id, self.cell),
         ]
         for group in self.groups_joined:
             await self.channel_layer.group_add(group, self.channel_name)
@@ -96,18 +99,22 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
         if isinstance(content, dict) and content.get("type") == "resync" and self.access:
             await self._send_snapshot()
 
-    # The channel layer's message, then one handler per event type ------------------------
+    # The channel layer's messages -------------------------------------------------------
 
     async def live_events(self, message: dict[str, Any]) -> None:
-        """The deltas of one commit: each goes through its type's handler, which says whether it
-        goes out now; those that do go in one frame (the sender's encoding, when it is all)."""
+        """The deltas of one commit: those for this socket's cell go out now, in one frame (the
+        sender's own encoding when none was left out); cobot states wait (on_cobot_state)."""
         events = message["events"]
         if not self._organisation_matches(message):
             return
         forwarded = []
         for event, cell in zip(events, message["cells"], strict=True):
-            handler = self._HANDLERS.get(event.get("type"))
-            if handler is not None and self._cell_matches(cell, event) and handler(self, event):
+            kind = event.get("type")
+            if not self._cell_matches(cell, event):
+                continue
+            if kind == "cobot-state":
+                self.on_cobot_state(event)
+            elif kind in PASSED_ON:
                 forwarded.append(event)
         if len(forwarded) == len(events):
             await self.send(text_data=message["text"])
@@ -115,28 +122,11 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             await self.send_json(forwarded)
 
     async def membership_ended(self, message: dict[str, Any]) -> None:
-        """An admin ended the user's membership (broadcast.membership_ended_on_commit)."""
+        """An admin ended the user's membership (groups.membership_ended_on_commit)."""
         if self._organisation_matches(message):
             await self.revoke()
 
-    # One handler per event type: True sends it now.
-
-    def on_case(self, event: LiveEvent) -> bool:
-        return True
-
-    def on_work_item(self, event: LiveEvent) -> bool:
-        return True
-
-    def on_incident(self, event: LiveEvent) -> bool:
-        return True
-
-    def on_cobot_queue(self, event: LiveEvent) -> bool:
-        return True
-
-    def on_cell_stop(self, event: LiveEvent) -> bool:
-        return True
-
-    def on_cobot_state(self, event: LiveEvent) -> bool:
+    def on_cobot_state(self, event: LiveEvent) -> None:
         """Kept: the latest state per cobot goes out at most every STATE_INTERVAL."""
         for state in event["states"]:  # type: ignore[typeddict-item]
             self._states[state["cobot"]] = state
@@ -145,16 +135,6 @@ class TabletConsumer(AsyncJsonWebsocketConsumer):  # type: ignore[misc]  # chann
             self._state_flush = asyncio.get_running_loop().call_later(
                 wait, lambda: asyncio.ensure_future(self._flush_states())
             )
-        return False
-
-    _HANDLERS = {
-        "case": on_case,
-        "work-item": on_work_item,
-        "incident": on_incident,
-        "cobot-queue": on_cobot_queue,
-        "cell-stop": on_cell_stop,
-        "cobot-state": on_cobot_state,
-    }
 
     # Helpers ------------------------------------------------------------------------------
 

@@ -30,7 +30,7 @@ from hrc.cobots.drivers.base import unreachable_message
 from hrc.cobots.endpoints import check_networks
 from hrc.cobots.models import Cobot
 from hrc.cobots.pki import PkiError, secure_client
-from hrc.live import broadcast, cobot_states
+from hrc.live import cobot_states, groups
 from hrc.live.events import CobotStateData
 
 logger = logging.getLogger(__name__)
@@ -237,7 +237,7 @@ class Monitor:
                 if watched.dirty or now - watched.sent_at > REFRESH_SECONDS:
                     watched.dirty, watched.sent_at = False, now
                     try:
-                        await broadcast.send_cobot_state(
+                        await groups.send_cobot_state(
                             watched.state, organisation=watched.organisation, cell=watched.cell
                         )
                         await sync_to_async(cobot_states.remember)(watched.state)

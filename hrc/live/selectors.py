@@ -1,8 +1,8 @@
 """Reads for the tablets: who may watch what, the snapshot, and cobot queues.
 
-The snapshot is built from the same rules as the deltas (hrc.live.broadcast
-builds both kinds of payload), so that applying a tablet's deltas to an old
-snapshot gives the fresh one; tests/live/test_event_stream.py checks it.
+The snapshot's rows go through the same builders as the deltas
+(hrc.live.payloads), so that applying a tablet's deltas to an old snapshot
+gives the fresh one; tests/live/test_event_stream.py checks it.
 """
 
 from __future__ import annotations
@@ -15,21 +15,19 @@ from django.db.models.fields.json import KeyTextTransform
 
 from hrc.cases.choices import OPEN_CASE_STATUSES, OPEN_WORK_ITEM_STATES, JobState
 from hrc.cases.models import Case, Incident, Job, WorkItem
-from hrc.cobots.models import Cobot
-from hrc.live import cobot_states
-from hrc.live.broadcast import candidates_of, cobots_of_mapping, now
+from hrc.cobots.models import CellStop, Cobot
+from hrc.live import cobot_states, payloads
 from hrc.live.events import (
     CaseData,
     CellStopData,
     CobotData,
     CobotQueueData,
-    CurrentStep,
     FloorCobot,
     IncidentData,
     Snapshot,
     WorkItemData,
 )
-from hrc.live.models import CellStop
+from hrc.live.payloads import INCIDENT_FIELDS, WORK_ITEM_FIELDS, JobRow
 from hrc.organisations.models import Membership, Organisation, Team
 from hrc.organisations.selectors import AnyUser, cells_of
 
@@ -140,16 +138,7 @@ def _open_cases(organisation: int) -> tuple[list[CaseData], dict[int, Any]]:
         .order_by("id")
         .values("id", "last_seq", "status", "name", "actor_mapping")
     )
-    cases: list[CaseData] = [
-        {
-            "id": row["id"],
-            "seq": row["last_seq"],
-            "status": row["status"],
-            "name": row["name"] or "",
-            "cobots": cobots_of_mapping(row["actor_mapping"]),
-        }
-        for row in rows
-    ]
+    cases = [payloads.case_data(row) for row in rows]  # type: ignore[arg-type]
     return cases, {row["id"]: row["actor_mapping"] for row in rows}
 
 
@@ -157,51 +146,18 @@ def _open_work_items(case_ids: list[int], mappings: dict[int, Any]) -> list[Work
     rows = (
         WorkItem.objects.filter(case_id__in=case_ids, state__in=sorted(OPEN_WORK_ITEM_STATES))
         .order_by("offered_at", "id")
-        .values(
-            "id", "case_id", "task", "label", "actor", "kind", "state", "instructions",
-            "team_id", "cobot_id", "claimed_by_id", "offered_at", "started_at",
-        )
-    )  # fmt: skip
-    return [
-        {
-            "id": row["id"],
-            "case": row["case_id"],
-            "task": row["task"],
-            "label": row["label"],
-            "actor": row["actor"],
-            "kind": row["kind"],
-            "state": row["state"],
-            "instructions": row["instructions"],
-            "team": row["team_id"],
-            "cobot": row["cobot_id"],
-            "candidates": candidates_of(mappings.get(row["case_id"]), row["actor"])
-            if row["kind"] == "operator"
-            else [],
-            "claimed_by": row["claimed_by_id"],
-            "offered_at": row["offered_at"].isoformat(),
-            "started_at": row["started_at"].isoformat() if row["started_at"] else None,
-        }
-        for row in rows
-    ]
+        .values(*WORK_ITEM_FIELDS)
+    )
+    return [payloads.work_item_data(row, mappings.get(row["case_id"])) for row in rows]
 
 
 def _open_incidents(case_ids: list[int]) -> list[IncidentData]:
     rows = (
         Incident.objects.filter(case_id__in=case_ids, resolved_at__isnull=True)
         .order_by("id")
-        .values("id", "case_id", "work_item_id", "kind", "message", "resolution")
+        .values(*INCIDENT_FIELDS)
     )
-    return [
-        {
-            "id": row["id"],
-            "case": row["case_id"],
-            "work_item": row["work_item_id"],
-            "kind": row["kind"],
-            "message": row["message"],
-            "resolution": row["resolution"],
-        }
-        for row in rows
-    ]
+    return [payloads.incident_data(row) for row in rows]
 
 
 def cobot_queues(cobot_ids: list[int]) -> list[tuple[int, str, CobotQueueData]]:
@@ -218,34 +174,15 @@ def cobot_queues(cobot_ids: list[int]) -> list[tuple[int, str, CobotQueueData]]:
             "command", task=F("work_item__task"), label=F("work_item__label"),
         )
     )  # fmt: skip
-    length: dict[int, int] = {}
-    current: dict[int, CurrentStep] = {}
-    waiting: dict[int, str] = {}
+    by_cobot: dict[int, list[JobRow]] = {}
     for job in jobs:
-        cobot = job["cobot_id"]
-        length[cobot] = length.get(cobot, 0) + 1
-        if job["state"] == JobState.RUNNING:
-            number = (job["command"] or {}).get("number")
-            current[cobot] = {
-                "case": job["case_id"], "work_item": job["work_item_id"], "task": job["task"],
-                "label": job["label"], "kind": job["kind"],
-                "step": int(number) if isinstance(number, int) else None,
-                "attempt": job["attempt"],
-            }  # fmt: skip
-        elif cobot not in waiting and job["waiting_for"]:
-            waiting[cobot] = job["waiting_for"]
-    at = now()
+        by_cobot.setdefault(job["cobot_id"], []).append(job)
+    at = payloads.now()
     return [
         (
             cobots[pk]["organisation_id"],
             cobots[pk]["cell"],
-            {
-                "cobot": pk,
-                "at": at,
-                "queue_length": length.get(pk, 0),
-                "current": current.get(pk),
-                "waiting_for": waiting.get(pk, ""),
-            },
+            payloads.cobot_queue_data(pk, by_cobot.get(pk, []), at),
         )
         for pk in cobot_ids
         if pk in cobots
@@ -258,18 +195,4 @@ def active_stop(organisation: int, cell: str) -> CellStopData | None:
     stop = stops.filter(cell=cell).select_related("stopped_by", "resumed_by").first()
     if stop is None and cell:
         stop = stops.filter(cell="").select_related("stopped_by", "resumed_by").first()
-    return stop_data(stop) if stop is not None else None
-
-
-def stop_data(stop: CellStop) -> CellStopData:
-    return {
-        "id": stop.pk,
-        "cell": stop.cell,
-        "at": now(),
-        "stopped_by": stop.stopped_by.get_username() if stop.stopped_by else "",
-        "stopped_at": stop.stopped_at.isoformat(),
-        "resumed_by": stop.resumed_by.get_username() if stop.resumed_by else "",
-        "resumed_at": stop.resumed_at.isoformat() if stop.resumed_at else None,
-        "cobots": list(stop.cobots),
-        "problems": dict(stop.problems),
-    }
+    return payloads.stop_data(stop) if stop is not None else None

@@ -14,8 +14,7 @@ from django.contrib.auth.models import User
 from rest_framework.test import APIClient
 
 from hrc.cobots import services as cobot_services
-from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
-from hrc.live.models import CellStop
+from hrc.cobots.models import CellStop, Cobot, CobotCommand, CredentialsSecret
 from hrc.organisations.models import Organisation
 from hrc.patterns import services
 from hrc.patterns.models import PatternModel, PatternVersion

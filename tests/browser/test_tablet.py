@@ -21,7 +21,7 @@ from hrc.cases.models import Case, Job, WorkItem
 from hrc.cobots import urua
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
-from hrc.live import broadcast
+from hrc.live import groups
 from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
@@ -134,7 +134,7 @@ def cell(
     finally:
         monitor.stop()
         server.stop()
-        broadcast.flush()
+        groups.flush()
         channel_layers.backends.clear()
 
 
@@ -287,7 +287,7 @@ def test_a_tablet_that_loses_its_socket_catches_up_after_reconnecting(
     case_services.start_case(
         choice_case.version, started_by=None, actor_mapping={"o": {"users": [operator.pk]}}
     )
-    broadcast.flush()
+    groups.flush()
 
     server.start()
     expect(page.locator(".connection")).to_have_text("Live", timeout=LIVE_MS)
@@ -362,11 +362,11 @@ def test_a_cells_tablet_offers_that_cells_tasks_and_says_how_many_wait_at_which_
     # Live, no reload: a new case at the paint cell only adds to the count; the operator's
     # paint task, once started from the floor, is theirs here too.
     start(paint)
-    broadcast.flush()
+    groups.flush()
     expect(page.locator(".elsewhere")).to_have_text("2 more tasks wait for you at the paint cell.")
     expect(cards).to_have_count(1)
     case_services.start_work_item(at_paint, user=operator)
-    broadcast.flush()
+    groups.flush()
     expect(cards).to_have_count(2)
     away = page.locator(f'.card[data-item="{at_paint.pk}"]')
     expect(away).to_have_attribute("data-state", "running")

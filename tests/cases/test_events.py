@@ -10,7 +10,7 @@ from django.db import transaction
 from hrc.cases import events
 from hrc.cases.choices import EventType
 from hrc.cases.models import Case, CaseEvent, WorkItem
-from hrc.live import broadcast
+from hrc.live import groups
 
 
 @pytest.fixture
@@ -44,9 +44,9 @@ def published(unregistered: None) -> list[tuple[Any, ...]]:
 
 
 def test_the_live_app_registers_its_sends_when_django_is_ready() -> None:
-    assert events._PUBLISHER.case_event is broadcast.case_event_on_commit
-    assert events._PUBLISHER.cobot_queue is broadcast.cobot_queue_on_commit
-    assert events._PUBLISHER.hold is broadcast.hold
+    assert events._PUBLISHER.case_event is groups.case_event_on_commit
+    assert events._PUBLISHER.cobot_queue is groups.cobot_queue_on_commit
+    assert events._PUBLISHER.hold is groups.hold
 
 
 @pytest.mark.django_db

@@ -4,7 +4,7 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 
-from hrc.live.models import CellStop
+from hrc.cobots.models import CellStop
 from hrc.organisations.models import Organisation
 
 pytestmark = pytest.mark.django_db
@@ -15,8 +15,8 @@ def test_stops_are_listed_and_read_only(
 ) -> None:
     stop = CellStop.objects.create(organisation=organisation, cell="A", stopped_by=operator)
 
-    listing = staff_client.get("/admin/live/cellstop/")
-    change = staff_client.post(f"/admin/live/cellstop/{stop.pk}/change/", {"cell": "B"})
+    listing = staff_client.get("/admin/cobots/cellstop/")
+    change = staff_client.post(f"/admin/cobots/cellstop/{stop.pk}/change/", {"cell": "B"})
 
     assert listing.status_code == 200
     assert operator.username in listing.content.decode()

@@ -14,14 +14,12 @@ import pytest
 from django.contrib.auth.models import User
 from rest_framework.test import APIClient
 
-from hrc.cobots import urua
+from hrc.cobots import stops, urua
 from hrc.cobots.drivers.base import Fence, StepCommand
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.gateway.launcher import GatewayProcess
-from hrc.cobots.models import Cobot
-from hrc.live import services
+from hrc.cobots.models import CellStop, Cobot
 from hrc.live.consumers import STATE_INTERVAL
-from hrc.live.models import CellStop
 from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
 from tests import factories
@@ -254,7 +252,7 @@ def test_a_stop_or_resume_without_a_named_cell_is_a_400_naming_cell(
 def test_the_stop_service_refuses_an_empty_cell(organisation: Organisation, operator: User) -> None:
     factories.make_cobot(organisation)
     with pytest.raises(ValueError, match="names its cell"):
-        services.stop_cell(organisation, "", by=operator)
+        stops.stop_cell(organisation, "", by=operator)
     assert not CellStop.objects.exists()
 
 

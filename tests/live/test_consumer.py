@@ -8,7 +8,7 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 
 from hrc.cases import services as case_services
 from hrc.cases.models import Case, WorkItem
-from hrc.live import broadcast
+from hrc.live import groups
 from hrc.live.consumers import RECHECK_SECONDS
 from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Membership, Organisation
@@ -104,7 +104,7 @@ def test_the_operator_gets_a_snapshot_then_numbered_deltas(
     [count] = WorkItem.objects.filter(case=choice_case)
 
     async def scenario() -> None:
-        await db(broadcast.flush)  # the case's start was broadcast before the tablet came
+        await db(groups.flush)  # the case's start was broadcast before the tablet came
         socket = await open_socket(server, cookie)
         snapshot = await receive(socket)
         assert snapshot["type"] == "snapshot"
@@ -118,7 +118,7 @@ def test_the_operator_gets_a_snapshot_then_numbered_deltas(
         assert item["candidates"] == [operator.pk]
 
         await db(case_services.start_work_item, count, user=operator)
-        await db(broadcast.flush)
+        await db(groups.flush)
         delta = await receive_until(socket, lambda e: e["type"] == "work-item")
         assert delta["case"] == choice_case.pk
         assert delta["seq"] == case["seq"] + 1
@@ -146,7 +146,7 @@ def test_an_outsider_connected_to_their_own_organisation_sees_nothing_of_ours(
         await receive(our_socket)
 
         await db(case_services.start_work_item, count, user=operator)
-        await db(broadcast.flush)
+        await db(groups.flush)
         # Ours arrives; by then theirs would have too.
         await receive_until(our_socket, lambda e: e["type"] == "work-item")
         with pytest.raises(TimeoutError):
@@ -228,12 +228,12 @@ def test_a_cell_tablet_gets_the_case_deltas_too(
     [count] = WorkItem.objects.filter(case=choice_case)
 
     async def scenario() -> None:
-        await db(broadcast.flush)
+        await db(groups.flush)
         socket = await open_socket(server, cookie, "?cell=A")
         snapshot = await receive(socket)
         assert snapshot["cell"] == "A"
         await db(case_services.claim_work_item, count, user=operator)
-        await db(broadcast.flush)
+        await db(groups.flush)
         delta = await receive_until(socket, lambda e: e["type"] == "work-item")
         assert delta["event"] == "task-claimed"
 

@@ -15,7 +15,7 @@ from hrc.cases import services as case_services
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.models import Case, Job, WorkItem
 from hrc.cases.simulation import Simulation
-from hrc.live import broadcast
+from hrc.live import groups
 from tests.cases.patterns import cobot_chain
 from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.replay import replay
@@ -74,11 +74,11 @@ def test_deltas_applied_to_an_old_snapshot_give_the_fresh_snapshot(
         _until(
             lambda: not Job.objects.filter(state__in=[JobState.QUEUED, JobState.RUNNING]).exists()
         )
-        broadcast.flush()
+        groups.flush()
 
     async def scenario() -> None:
         cases = await db(simulation.start_cases, 3)
-        await db(broadcast.flush)
+        await db(groups.flush)
         socket = await open_socket(server, cookie)
         old = await receive(socket)
         assert [case["id"] for case in old["cases"]] == cases
@@ -121,14 +121,14 @@ def test_a_missed_delta_is_found_by_its_number(server: LiveServer, simulation: S
 
     async def scenario() -> None:
         [case_id] = await db(simulation.start_cases, 1)
-        await db(broadcast.flush)
+        await db(groups.flush)
         socket = await open_socket(server, cookie)
         old = await receive(socket)
         item = await db(_operator_item, case_id)
         await db(case_services.claim_work_item, item, user=operator)
         await db(case_services.unclaim_work_item, item, user=operator)
         await db(case_services.claim_work_item, item, user=operator)
-        await db(broadcast.flush)
+        await db(groups.flush)
         deltas = [await receive(socket) for _ in range(3)]
         assert [d["seq"] for d in deltas] == [old["cases"][0]["seq"] + n for n in (1, 2, 3)]
 

@@ -16,7 +16,8 @@ from rest_framework.views import APIView
 
 from hrc.api.exceptions import Rejected
 from hrc.cases.api.serializers import RefusalSerializer
-from hrc.live import selectors, services
+from hrc.cobots import stops
+from hrc.live import payloads, selectors
 from hrc.live.api.serializers import (
     CellRequestSerializer,
     CellStopSerializer,
@@ -40,9 +41,9 @@ class StopCellView(APIView):
         organisation = _organisation(request, body.validated_data.get("organisation"))
         cell = _cell(organisation, body.validated_data["cell"])
         before = selectors.active_stop(organisation.pk, cell)
-        stop = services.stop_cell(organisation, cell, by=request.user)  # type: ignore[arg-type]
+        stop = stops.stop_cell(organisation, cell, by=request.user)  # type: ignore[arg-type]
         code = status.HTTP_200_OK if before and before["id"] == stop.pk else status.HTTP_201_CREATED
-        return Response(selectors.stop_data(stop), status=code)
+        return Response(payloads.stop_data(stop), status=code)
 
 
 class ResumeCellView(APIView):
@@ -55,15 +56,15 @@ class ResumeCellView(APIView):
         organisation = _organisation(request, body.validated_data.get("organisation"))
         cell = _cell(organisation, body.validated_data["cell"])
         try:
-            stop = services.resume_cell(
+            stop = stops.resume_cell(
                 organisation,
                 cell,
                 by=request.user,  # type: ignore[arg-type]
                 confirmed=body.validated_data["confirm"],
             )
-        except services.StopError as error:
+        except stops.StopError as error:
             raise Rejected({"detail": str(error)}, error.status) from None
-        return Response(selectors.stop_data(stop))
+        return Response(payloads.stop_data(stop))
 
 
 def _organisation(request: Request, requested: Any) -> Organisation:

@@ -1,4 +1,4 @@
-"""Every write of the live layer: a tablet's STOP of a cell, and the confirmed resume.
+"""A tablet's STOP of a cell, and the confirmed resume.
 
 STOP is a convenience, not a safety function: it pauses the programs of the
 cell's cobots (PauseProgram, what a space constraint's interruption sends)
@@ -8,9 +8,10 @@ the robots' own safety systems stay in charge. Resuming needs an explicit
 confirmation and restarts only the programs that are paused and that no
 operator's interruption still holds.
 
-The cobot commands go out after the rows are committed, outside the
-transaction (a robot is not rolled back); what a cobot refused is recorded
-on the CellStop and shown on the tablets.
+The rows are committed first; the cobot commands follow outside the
+transaction (hrc.cobots.commands), and what a cobot refused is recorded on
+the CellStop and shown on the tablets (hrc.cobots.hooks: the live app tells
+them, the cases app knows interruptions and starts the queues again).
 """
 
 from __future__ import annotations
@@ -20,19 +21,13 @@ from concurrent.futures import ThreadPoolExecutor
 
 from django.contrib.auth.models import User
 from django.db import IntegrityError, connections, transaction
-from django.db.models import Q
 from django.utils import timezone
 
-from hrc.cases import dispatch
-from hrc.cases.choices import JobState
-from hrc.cases.dispatch import Task
-from hrc.cases.models import Interruption, Job
-from hrc.cobots import urua
+from hrc.cobots import hooks, urua
+from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
-from hrc.cobots.models import Cobot
-from hrc.live import broadcast
-from hrc.live.models import CellStop
-from hrc.live.selectors import stop_data
+from hrc.cobots.drivers.runner import driver_for_cobot
+from hrc.cobots.models import CellStop, Cobot
 from hrc.organisations.models import Organisation
 
 # Seconds a cobot may take to answer PauseProgram or StartProgram.
@@ -69,13 +64,10 @@ def stop_cell(organisation: Organisation, cell: str, *, by: User) -> CellStop:
             found = _active(organisation, cell)
             assert found is not None
             return found
-        now = timezone.now()
-        Cobot.objects.filter(pk__in=[c.pk for c in cobots]).update(stopped_at=now)
+        Cobot.objects.filter(pk__in=[c.pk for c in cobots]).update(stopped_at=timezone.now())
         for cobot in cobots:
-            broadcast.cobot_queue_on_commit(cobot.pk)
-    stop.problems = _command_all(cobots, _pause)
-    stop.save(update_fields=["problems"])
-    _broadcast(stop)
+            hooks.queue_changed(cobot.pk)
+    _record_problems(stop, _command_all(cobots, _pause))
     return stop
 
 
@@ -102,19 +94,17 @@ def resume_cell(organisation: Organisation, cell: str, *, by: User, confirmed: b
         held = list(Cobot.objects.select_for_update(no_key=True).filter(pk__in=stop.cobots))
         Cobot.objects.filter(pk__in=[c.pk for c in held]).update(stopped_at=None)
         for cobot in held:
-            broadcast.cobot_queue_on_commit(cobot.pk)
-            first = (
-                Job.objects.filter(cobot=cobot, state=JobState.QUEUED)
-                .values_list("pk", flat=True)
-                .first()
-            )
-            if first is not None:
-                dispatch.send_on_commit(Task.RUN_JOB, first)  # the queue waited for the resume
-    problems = _command_all(held, _restart)
-    stop.problems = {**stop.problems, **problems}
-    stop.save(update_fields=["problems"])
-    _broadcast(stop)
+            hooks.queue_changed(cobot.pk)
+            hooks.queue_released(cobot.pk)  # the queue waited for the resume
+    _record_problems(stop, {**stop.problems, **_command_all(held, _restart)})
     return stop
+
+
+def _record_problems(stop: CellStop, problems: dict[str, str]) -> None:
+    with transaction.atomic():
+        stop.problems = problems
+        stop.save(update_fields=["problems"])
+        hooks.stop_changed(stop)
 
 
 def _active(organisation: Organisation, cell: str) -> CellStop | None:
@@ -144,15 +134,16 @@ def _command_all(cobots: list[Cobot], command: Callable[[Cobot], str]) -> dict[s
         finally:
             connections.close_all()  # the pool thread's own connection, if it opened one
 
-    with ThreadPoolExecutor(max_workers=min(8, len(cobots))) as pool:
-        outcomes = list(pool.map(run, cobots))
+    def run_all() -> list[str]:
+        with ThreadPoolExecutor(max_workers=min(8, len(cobots))) as pool:
+            return list(pool.map(run, cobots))
+
+    outcomes = outside_transaction(run_all)
     return {str(c.pk): problem for c, problem in zip(cobots, outcomes, strict=True) if problem}
 
 
 def _pause(cobot: Cobot) -> str:
     """ "" when the cobot's program is paused (or was not playing); otherwise why not."""
-    from hrc.cobots.drivers.runner import driver_for_cobot
-
     try:
         driver = driver_for_cobot(cobot, connect_timeout=COMMAND_TIMEOUT)
         state = driver.state()
@@ -166,13 +157,8 @@ def _pause(cobot: Cobot) -> str:
 
 def _restart(cobot: Cobot) -> str:
     """Restarts a paused program unless an interruption or a safety stop still holds the cobot."""
-    from hrc.cobots.drivers.runner import driver_for_cobot
-
-    unsettled = Interruption.objects.filter(cobot=cobot).filter(
-        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
-    )
     try:
-        if unsettled.exists():
+        if hooks.held_by_interruption(cobot.pk):
             return ""  # the operator in the shared area resumes it when done
         driver = driver_for_cobot(cobot, connect_timeout=COMMAND_TIMEOUT)
         state = driver.state()
@@ -184,17 +170,6 @@ def _restart(cobot: Cobot) -> str:
     except DriverError as error:
         return f"not restarted: {error}"
     return ""
-
-
-def _broadcast(stop: CellStop) -> None:
-    with transaction.atomic():  # send_event_on_commit waits for a commit
-        stop = CellStop.objects.select_related("stopped_by", "resumed_by").get(pk=stop.pk)
-        broadcast.send_event_on_commit(
-            [broadcast.organisation_group(stop.organisation_id)],
-            {"type": "cell-stop", "stop": stop_data(stop)},
-            organisation=stop.organisation_id,
-            cell=stop.cell,
-        )
 
 
 def _name(cell: str) -> str:
