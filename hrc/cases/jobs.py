@@ -45,7 +45,6 @@ from hrc.cases.choices import (
 from hrc.cases.models import Case, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
-from hrc.cobots import urua
 from hrc.cobots.control import running_commands
 from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
@@ -60,6 +59,7 @@ from hrc.cobots.models import Cobot
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet
 from hrc.live import broadcast as live
+from hrc_gateway import urua
 
 logger = logging.getLogger(__name__)
 

@@ -26,13 +26,13 @@ from django.utils import timezone
 from hrc.cases import dispatch
 from hrc.cases.choices import JobState
 from hrc.cases.models import Interruption, Job
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.models import Cobot
 from hrc.live import broadcast
 from hrc.live.models import CellStop
 from hrc.live.selectors import stop_data
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 
 # Seconds a cobot may take to answer PauseProgram or StartProgram.
 COMMAND_TIMEOUT = 5.0
