@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import functools
 import gc
 import importlib
 import os
@@ -114,11 +115,14 @@ def serve(options: Mapping[str, Any], defaults: Defaults, say: Callable[[str], N
 
 def main(argv: Sequence[str] | None = None) -> int:
     """The console script: flags from the command line, defaults from the environment."""
-    parser = argparse.ArgumentParser(prog="hrc-gateway", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="hrc-gateway", description="Serves one cobot over OPC UA with URUA's address space."
+    )
     add_arguments(parser)
     options = vars(parser.parse_args(argv))
     try:
-        serve(options, environment_defaults(), print)
+        # Flushed: whoever started the gateway waits for the line that says it serves.
+        serve(options, environment_defaults(), functools.partial(print, flush=True))
     except StartError as error:
         print(f"{parser.prog}: error: {error}", file=sys.stderr)
         return 1

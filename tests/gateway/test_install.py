@@ -7,7 +7,6 @@ project's lock), then `hrc-gateway`. The test process talks to it over OPC UA.
 
 from __future__ import annotations
 
-import os
 import shutil
 import signal
 import subprocess
@@ -72,7 +71,6 @@ def gateway(venv: Path, tmp_path: Path) -> Iterator[str]:
             [venv / "bin" / "hrc-gateway", "--name", "cobot1", "--port", str(port),
              "--insecure", "--time-scale", "0", "--state-file", tmp_path / "cobot1.json"],
             cwd=tmp_path, stdout=out, stderr=subprocess.STDOUT,
-            env={**os.environ, "PYTHONUNBUFFERED": "1"},
         )  # fmt: skip
     try:
         deadline = time.monotonic() + 30
