@@ -36,7 +36,7 @@ install: $(STAMP) $(FRONTEND_BUILD)  ## create .venv, install the locked Python 
 
 demo: install  ## migrate, load the demo people and examples, start two simulated cobots and the server on 127.0.0.1:8000 (Ctrl-C stops all)
 	@mkdir -p var  # the embedded SQLite database lives here when DATABASE_URL is unset
-	@# hrc/patterns/management/commands/demo.py: prints the passwords once; e.g. DEMO_ARGS="--port 8001"
+	@# hrc/demo/management/commands/demo.py: prints the passwords once; e.g. DEMO_ARGS="--port 8001"
 	$(PY) manage.py demo $(DEMO_ARGS)
 
 $(CHROMIUM):
@@ -50,7 +50,7 @@ test: install $(BENCH_STAMP) $(CHROMIUM)  ## run the whole test suite (PostgreSQ
 lint: install  ## ruff, mypy, tsc, ESLint, the import contracts, the docs build
 	.venv/bin/ruff check .
 	.venv/bin/ruff format --check .
-	.venv/bin/mypy hrc tests bench
+	.venv/bin/mypy hrc hrc_gateway tests bench
 	cd frontend && npx tsc --noEmit
 	cd frontend && npx eslint .
 	NO_MKDOCS_2_WARNING=1 .venv/bin/mkdocs build --strict --quiet  # docs/ into site/ (ignored)

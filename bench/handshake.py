@@ -43,9 +43,9 @@ def percentile(samples: list[float], fraction: float) -> float:
 async def _measure(endpoint: str, steps: int, warmup: int) -> dict[str, list[float]]:
     from asyncua import Client, ua
 
-    from hrc.cobots import urua
     from hrc.cobots.drivers.base import Fence, StepCommand
     from hrc.cobots.drivers.opcua.driver import OpcUaDriver
+    from hrc_gateway import urua
 
     driver = OpcUaDriver("cobot1", endpoint, step_timeout=10.0)
     await driver.call("PowerOn", timeout=30)
@@ -81,7 +81,7 @@ async def _measure(endpoint: str, steps: int, warmup: int) -> dict[str, list[flo
 
 def run(steps: int, warmup: int, results_dir: Path) -> dict[str, Any]:
     os.environ.setdefault("DJANGO_SETTINGS_MODULE", "hrc.settings.dev")
-    from hrc.cobots.gateway.launcher import GatewayProcess
+    from hrc.cobots.simulated import GatewayProcess
 
     with tempfile.TemporaryDirectory() as scratch:
         gateway = GatewayProcess("cobot1", Path(scratch) / "cobot1.json", time_scale=0.0)

@@ -203,9 +203,9 @@ class Rig:
 
 @contextlib.contextmanager
 def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
-    from hrc.cases.launcher import RedisProcess, WorkerProcess
-    from hrc.cobots import urua
-    from hrc.cobots.gateway.launcher import GatewayProcess
+    from hrc.cobots.simulated import GatewayProcess
+    from hrc_gateway import urua
+    from tests.support.workers import RedisProcess, WorkerProcess
 
     with contextlib.ExitStack() as stack:
         workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="hrc-bench-live-")))
@@ -292,7 +292,7 @@ def _close_connections() -> None:
 def measure_ours(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:
     from hrc.cases import services
     from hrc.cases.models import CaseEvent, Job
-    from hrc.cobots import urua
+    from hrc_gateway import urua
 
     latencies: list[float] = []
     spreads: list[float] = []

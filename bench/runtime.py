@@ -73,7 +73,7 @@ if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the 
 
 
 def measure_signalling(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
-    from hrc.cobots import urua
+    from hrc_gateway import urua
 
     bench.use_workers(1)
     floors = {"celery_dispatch": _celery_floor(bench, settings)}
@@ -103,7 +103,7 @@ def _signal_one_step(bench: Rig, observer: Observer) -> tuple[float, float, floa
     """
     from hrc.cases import services
     from hrc.cases.models import Job, WorkItem
-    from hrc.cobots import urua
+    from hrc_gateway import urua
 
     case = services.start_case(bench.signal, started_by=None)
     item = WorkItem.objects.get(case=case, task="to1")
@@ -214,7 +214,7 @@ async def _opcua_floors(observer: Observer, settings: Settings) -> dict[str, lis
     """A raw write of one Int32 input register: its response, and its sight by the observer."""
     from asyncua import Client, ua
 
-    from hrc.cobots import urua
+    from hrc_gateway import urua
 
     raw = Client(observer.endpoint)
     await raw.connect()

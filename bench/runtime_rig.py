@@ -36,10 +36,10 @@ from bench.handshake import percentile
 if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the functions
     from django.contrib.auth.models import User
 
-    from hrc.cases.launcher import RedisProcess, WorkerProcess
-    from hrc.cobots.gateway.launcher import GatewayProcess
     from hrc.cobots.models import Cobot
+    from hrc.cobots.simulated import GatewayProcess
     from hrc.patterns.models import PatternVersion
+    from tests.support.workers import RedisProcess, WorkerProcess
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS_DIR = ROOT / "bench" / "results"
@@ -233,7 +233,7 @@ class Observer:
     async def _connect(self) -> None:
         from asyncua import Client, ua
 
-        from hrc.cobots import urua
+        from hrc_gateway import urua
 
         self._client = Client(self.endpoint)
         await self._client.connect()
@@ -299,7 +299,7 @@ class ApiServer:
     """
 
     def __init__(self, workdir: Path, environment: Mapping[str, str]) -> None:
-        from hrc.cobots.gateway.launcher import free_port
+        from hrc.cobots.simulated import free_port
 
         self.port = free_port()
         self.log = workdir / "daphne.log"
@@ -408,7 +408,7 @@ class FloorWorker:
         return f"floor@{socket.gethostname()}"
 
     def pids(self) -> set[int]:
-        from hrc.cases.launcher import process_group  # not at module level: see the docstring
+        from tests.support.workers import process_group  # not at module level: see the docstring
 
         return process_group(self.process.pid) if self.process is not None else set()
 
@@ -442,7 +442,7 @@ class Rig:
 
     def use_workers(self, count: int) -> None:
         """Exactly `count` workers running; the first runs the beat that runs the sweeper."""
-        from hrc.cases.launcher import WorkerProcess
+        from tests.support.workers import WorkerProcess
 
         while len(self.workers) > count:
             self.workers.pop().stop()
@@ -464,7 +464,7 @@ class Rig:
 
 @contextlib.contextmanager
 def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Rig]:
-    from hrc.cases.launcher import RedisProcess
+    from tests.support.workers import RedisProcess
 
     with contextlib.ExitStack() as stack:
         workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="hrc-bench-")))
@@ -525,8 +525,8 @@ def _populate(workdir: Path, cobots: int, gateways: list[GatewayProcess]) -> dic
 
     from hrc.cases import services
     from hrc.cobots.drivers.runner import driver_for
-    from hrc.cobots.gateway.launcher import GatewayProcess
     from hrc.cobots.models import Cobot
+    from hrc.cobots.simulated import GatewayProcess
     from hrc.organisations import services as organisations
     from hrc.organisations.choices import Role
     from hrc.patterns import services as patterns

@@ -55,7 +55,7 @@ from bench.runtime_rig import (
 )
 
 if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the functions
-    from hrc.cases.launcher import RedisProcess, WorkerProcess
+    from tests.support.workers import RedisProcess, WorkerProcess
 
 USE_CASES_DIR = ROOT / "hrc" / "patterns" / "examples" / "use_cases"
 CASE_TIMEOUT = 600.0
@@ -163,7 +163,7 @@ def summarise(cases: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
 @contextlib.contextmanager
 def rig(settings: Settings, progress: Callable[[str], None]) -> Iterator[Path]:
     """A scratch database, a private broker and `settings.workers` Celery workers; yields a workdir."""
-    from hrc.cases.launcher import RedisProcess, WorkerProcess
+    from tests.support.workers import RedisProcess, WorkerProcess
 
     with contextlib.ExitStack() as stack:
         workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="hrc-bench-uc-")))

@@ -17,7 +17,7 @@ import pytest
 from django.conf import settings
 from django.db import connection
 
-from hrc.cobots.gateway.launcher import free_port
+from hrc.cobots.simulated import free_port
 from tests.cases.test_run_pattern_embedded import ROOT, embedded_environment
 
 

@@ -57,6 +57,7 @@ def test_the_layer_contracts_hold() -> None:
     ("module", "outward", "contract"),
     [
         ("hrc/engine/outward.py", "import django\n", "The engine is pure"),
+        ("hrc_gateway/outward.py", "from hrc.cobots import models\n", "The gateway installs alone"),
         ("hrc/cobots/outward.py", "from hrc.cases import models\n", "Apps point inwards"),
         ("hrc/cases/outward.py", "from hrc.live import consumers\n", "Apps point inwards"),
         (

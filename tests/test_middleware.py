@@ -9,7 +9,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from hrc.cobots.gateway.launcher import free_port
+from hrc.cobots.simulated import free_port
 from tests.live.server import LiveServer
 
 API_REQUESTS: list[tuple[str, str, object]] = [

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-from hrc.cobots.gateway.launcher import free_port
+from hrc.cobots.simulated import free_port
 from tests.cases.test_run_pattern_embedded import ROOT, embedded_environment
 
 FENCE = re.compile(r"^```([^\n]*)\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -40,7 +40,7 @@ CANNOT_RUN = {
     "--robot 192.168.0.210 --program hrc_steps": "needs a UR controller at 192.168.0.210",
     ".venv/bin/celery -A hrc worker --beat --loglevel INFO": (
         "needs Redis as the broker; tests/cases/test_workers.py starts this worker "
-        "(hrc.cases.launcher.WorkerProcess) against a private Redis"
+        "(tests.support.workers.WorkerProcess) against a private Redis"
     ),
     "cd docker": "docker: no engine here",
     "cp /dev/null .env && chmod 600 .env": "docker: the compose file's .env, in docker/",

@@ -21,10 +21,10 @@ from hrc.cases import dispatch
 from hrc.cases.choices import JobState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
-from hrc.cobots import urua
 from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
+from hrc_gateway import urua
 
 SLOW_OVERRIDE_PERCENT = 10.0
 FULL_OVERRIDE_PERCENT = 100.0

@@ -46,7 +46,6 @@ from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
-from hrc.cobots import urua
 from hrc.cobots.control import running_commands
 from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
@@ -60,6 +59,7 @@ from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet
+from hrc_gateway import urua
 
 logger = logging.getLogger(__name__)
 

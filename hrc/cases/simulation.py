@@ -54,8 +54,8 @@ from hrc.cases.errors import CaseError
 from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
-from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot
+from hrc.cobots.simulated import GatewayProcess
 from hrc.engine.model import Pattern
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation

@@ -6,9 +6,9 @@ from django.db import models
 class DriverKind(models.TextChoices):
     """Which driver talks to the cobot."""
 
-    # A gateway with the simulated backend (hrc/cobots/gateway/sim/), a stand-in for URSim + URUA.
+    # A gateway with the simulated backend (hrc_gateway/sim/), a stand-in for URSim + URUA.
     SIMULATED = "simulated", "Simulated (OPC UA simulator)"
-    # A Universal Robots controller behind a gateway with the ur-rtde backend (hrc/cobots/gateway/ur/).
+    # A Universal Robots controller behind a gateway with the ur-rtde backend (hrc_gateway/ur/).
     UR = "ur", "Universal Robots (OPC UA + RTDE)"
 
 

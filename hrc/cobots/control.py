@@ -25,7 +25,7 @@ from django.db import transaction
 from django.db.models import QuerySet
 from django.utils import timezone
 
-from hrc.cobots import hooks, urua
+from hrc.cobots import hooks
 from hrc.cobots.choices import CommandOutcome, ControlCommand
 from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import (
@@ -36,6 +36,7 @@ from hrc.cobots.drivers.base import (
 )
 from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot, CobotCommand
+from hrc_gateway import urua
 
 # Seconds a command may take: a UR powering on and releasing its brakes takes several.
 COMMAND_TIMEOUT: Final = 30.0
@@ -44,7 +45,7 @@ CONNECT_TIMEOUT: Final = 5.0
 # A command unanswered for this long died with its process: it no longer holds the cobot.
 STALE_AFTER: Final = dt.timedelta(seconds=COMMAND_TIMEOUT + 30)
 
-# The URUA method each command calls (hrc/cobots/gateway/server.py).
+# The URUA method each command calls (hrc_gateway/server.py).
 METHODS: Final = {
     ControlCommand.POWER_ON: "PowerOn",
     ControlCommand.BRAKE_RELEASE: "BrakeRelease",

@@ -11,7 +11,6 @@ from django.conf import settings
 from django.core.exceptions import ValidationError
 from django.db import models
 
-from hrc.cobots import endpoints
 from hrc.cobots.choices import CommandOutcome, ControlCommand, CredentialsKind, DriverKind
 from hrc.cobots.validators import (
     split_credentials_source,
@@ -21,6 +20,7 @@ from hrc.cobots.validators import (
 )
 from hrc.organisations.models import Organisation
 from hrc.organisations.validators import validate_cell
+from hrc_gateway import endpoints
 
 
 class Cobot(models.Model):
@@ -61,7 +61,7 @@ class Cobot(models.Model):
         null=True,
         editable=False,
         help_text=(
-            "The endpoint as the network sees it (hrc.cobots.endpoints.endpoint_key); unique, so one "
+            "The endpoint as the network sees it (hrc_gateway.endpoints.endpoint_key); unique, so one "
             "gateway is one cobot's. Empty only for a cobot that shared its endpoint before the rule."
         ),
     )

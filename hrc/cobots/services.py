@@ -79,7 +79,7 @@ def _reject_unknown(fields: dict[str, Any]) -> None:
 
 # Credentials secrets -----------------------------------------------------------------
 
-# The gateways' user names (hrc.cobots.pki): no blank and no ':'.
+# The gateways' user names (hrc_gateway.pki): no blank and no ':'.
 _USERNAME = re.compile(r"[^\s:]{1,64}")
 MAX_PASSWORD = 1024
 

@@ -23,12 +23,13 @@ from django.contrib.auth.models import User
 from django.db import IntegrityError, connections, transaction
 from django.utils import timezone
 
-from hrc.cobots import hooks, urua
+from hrc.cobots import hooks
 from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
 from hrc.cobots.models import CellStop, Cobot
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 
 # Seconds a cobot may take to answer PauseProgram or StartProgram.
 COMMAND_TIMEOUT = 5.0

@@ -11,7 +11,7 @@ from urllib.parse import urlsplit
 from django.core.exceptions import ValidationError
 
 from hrc.cobots.choices import CredentialsKind
-from hrc.cobots.endpoints import EndpointError, endpoint_key
+from hrc_gateway.endpoints import EndpointError, endpoint_key
 
 ENDPOINT_SCHEME = "opc.tcp"
 SECRET_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")

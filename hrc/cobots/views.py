@@ -22,7 +22,7 @@ from django.shortcuts import render
 from django.urls import reverse
 from django.views.decorators.http import require_http_methods
 
-from hrc.cobots import control, hooks, services, urua
+from hrc.cobots import control, hooks, services
 from hrc.cobots.choices import ControlCommand
 from hrc.cobots.forms import CobotForm, CredentialsSecretForm
 from hrc.cobots.models import Cobot
@@ -36,6 +36,7 @@ from hrc.navigation import current_membership
 from hrc.organisations.choices import WRITER_ROLES, AdminAction, Role
 from hrc.organisations.selectors import may_write_in, writable_organisations
 from hrc.organisations.services import record_admin_action
+from hrc_gateway import urua
 
 ENGINEERS_ONLY = "Only engineers and admins of the organisation control its cobots."
 ADMINS_ONLY = "Only admins of the organisation set its cobots' credentials."

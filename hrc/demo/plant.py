@@ -20,9 +20,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for
+from hrc_gateway import urua
 
 # Seconds a cobot may take from PowerOn to Running; the simulator needs 1.5 s at --time-scale 1.
 PREPARE_TIMEOUT = 30.0

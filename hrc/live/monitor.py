@@ -24,14 +24,14 @@ from asyncua import Client, Node, ua
 from django.conf import settings
 from django.db import connections
 
-from hrc.cobots import urua
 from hrc.cobots.credentials import CredentialsError, credentials_for
 from hrc.cobots.drivers.base import unreachable_message
-from hrc.cobots.endpoints import check_networks
 from hrc.cobots.models import Cobot
-from hrc.cobots.pki import PkiError, secure_client
 from hrc.live import cobot_states, groups
 from hrc.live.events import CobotStateData
+from hrc_gateway import urua
+from hrc_gateway.endpoints import check_networks
+from hrc_gateway.pki import PkiError, secure_client
 
 logger = logging.getLogger(__name__)
 

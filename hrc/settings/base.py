@@ -42,6 +42,7 @@ INSTALLED_APPS = [
     "hrc.cases",
     "hrc.live",
     "hrc.analytics",
+    "hrc.demo",
 ]
 
 MIDDLEWARE = [
@@ -262,7 +263,7 @@ SPECTACULAR_SETTINGS = {
     "SWAGGER_UI_SETTINGS": {"deepLinking": True, "validatorUrl": None},
 }
 
-# Cobot gateways and drivers. Certificates and trust lists (hrc.cobots.pki);
+# Cobot gateways and drivers. Certificates and trust lists (hrc_gateway.pki);
 # keep this directory out of backups that leave the plant.
 HRC_PKI_DIR = Path(env_str("HRC_PKI_DIR") or VAR_DIR / "pki")
 # The simulator's controller state, so a simulated cobot survives a gateway restart.

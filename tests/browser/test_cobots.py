@@ -12,10 +12,10 @@ import pytest
 from django.contrib.auth.models import User
 from playwright.sync_api import Page, expect
 
-from hrc.cobots import urua
-from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import CobotCommand
+from hrc.cobots.simulated import GatewayProcess
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 from tests import factories
 
 pytestmark = pytest.mark.django_db(transaction=True)

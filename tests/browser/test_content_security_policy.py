@@ -26,9 +26,9 @@ from playwright.sync_api import (
     expect,
 )
 
-from hrc.cobots.gateway.launcher import ROOT
 from tests.browser.conftest import TABLET
 from tests.demo.rig import DemoRun
+from tests.support.paths import ROOT
 
 SUPERUSER = ("root", "Csp-test-superuser-7")
 LIVE = 30_000

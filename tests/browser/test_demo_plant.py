@@ -26,11 +26,11 @@ from typing import Any
 import pytest
 from playwright.sync_api import Browser, Page, expect
 
-from hrc.cases.launcher import RedisProcess
-from hrc.cobots.gateway.launcher import ROOT
 from hrc.demo.plant import STARTED_CASES
 from tests.browser.conftest import TABLET
 from tests.demo.rig import DemoRun, alive, scratch_postgres
+from tests.support.paths import ROOT
+from tests.support.workers import RedisProcess
 
 Screenshot = Callable[[Page, str], Path]
 FIXTURE = STARTED_CASES[1][0]

@@ -31,8 +31,7 @@ from typing import Any
 import pytest
 from playwright.sync_api import Browser, Page, ViewportSize, expect
 
-from hrc.cases.launcher import RedisProcess
-from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
 from tests.browser.conftest import TABLET, assert_fits
 from tests.browser.drawing import (
     CHECKED,
@@ -48,6 +47,7 @@ from tests.browser.drawing import (
 )
 from tests.demo.rig import DemoRun, scratch_postgres
 from tests.polling import until
+from tests.support.workers import RedisProcess
 
 Screenshot = Callable[[Page, str], Path]
 LIVE_MS = 60_000

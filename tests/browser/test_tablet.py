@@ -16,21 +16,21 @@ from playwright.sync_api import Browser, BrowserContext, Page, ViewportSize, exp
 
 from hrc.cases import services as case_services
 from hrc.cases.choices import CaseStatus, EventType, JobState
-from hrc.cases.launcher import RedisProcess, WorkerProcess
 from hrc.cases.models import Case, Job, WorkItem
-from hrc.cobots import urua
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
-from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
 from hrc.live import groups
 from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
 from hrc.patterns.models import PatternVersion
+from hrc_gateway import urua
 from tests import factories
 from tests.browser.conftest import assert_fits
 from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.live.server import LiveServer, MonitorProcess
 from tests.polling import until
+from tests.support.workers import RedisProcess, WorkerProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

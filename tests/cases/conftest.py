@@ -15,8 +15,8 @@ from pathlib import Path
 import pytest
 from django.db import connection
 
-from hrc.cases.launcher import RedisProcess, WorkerProcess
 from hrc.celery import app
+from tests.support.workers import RedisProcess, WorkerProcess
 
 
 @pytest.fixture

@@ -23,7 +23,6 @@ from django.utils import timezone
 from hrc.cases import jobs
 from hrc.cases import services as case_services
 from hrc.cases.choices import JobState
-from hrc.cases.launcher import RedisProcess
 from hrc.cases.models import Case, Job
 from hrc.celery import app
 from hrc.cobots.choices import CommandOutcome, ControlCommand
@@ -31,6 +30,7 @@ from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PROGRAM
+from tests.support.workers import RedisProcess
 
 
 def _one_cobot_task() -> dict[str, Any]:

@@ -10,11 +10,11 @@ from django.contrib.auth.models import User
 
 from hrc.cases import dispatch, services
 from hrc.cases.choices import JobState
-from hrc.cases.launcher import RedisProcess
 from hrc.cases.models import Job
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import cobot_chain
+from tests.support.workers import RedisProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

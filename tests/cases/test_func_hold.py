@@ -20,7 +20,6 @@ from django.contrib.auth.models import User
 
 from hrc.cases import dispatch, jobs, services
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
-from hrc.cases.launcher import RedisProcess
 from hrc.cases.models import Case, Job, WorkItem
 from hrc.cases.selectors import cobot_in_use
 from hrc.cases.simulation import Simulation
@@ -30,6 +29,7 @@ from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PICK, func_hold
 from tests.polling import until
+from tests.support.workers import RedisProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

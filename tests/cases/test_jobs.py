@@ -14,7 +14,7 @@ from hrc.cases import services
 from hrc.cases.choices import CaseStatus, IncidentKind, JobState, WorkItemState
 from hrc.cases.models import Case, Incident, Interruption, Job, WorkItem
 from hrc.cases.simulation import Simulation
-from hrc.cobots import urua
+from hrc_gateway import urua
 from tests.cases.patterns import scan_until_found, shared_space, unusable_outputs
 from tests.polling import until
 

@@ -15,12 +15,12 @@ from hrc.cases import jobs
 from hrc.cases.choices import CaseStatus, IncidentKind, JobState
 from hrc.cases.models import Case, Incident, Interruption, Job
 from hrc.cases.simulation import Simulation
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import CobotNotReady, CobotPaused
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
-from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 from tests import factories
 from tests.cases.patterns import PROGRAM, cobot_chain
 from tests.polling import until

@@ -16,10 +16,10 @@ from pathlib import Path
 import pytest
 
 from hrc.cases.choices import CaseStatus, JobState
-from hrc.cases.launcher import RedisProcess, WorkerProcess
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
 from tests.cases.patterns import cobot_chain
+from tests.support.workers import RedisProcess, WorkerProcess
 
 TRIALS = 3
 CASES_PER_TRIAL = 2

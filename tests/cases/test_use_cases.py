@@ -20,11 +20,11 @@ from typing import Any
 import pytest
 
 from hrc.cases.choices import CaseStatus, JobState, WorkItemKind
-from hrc.cases.launcher import WorkerProcess
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
 from hrc.engine import check_document, read_pattern
 from tests.cases.test_run_pattern import check_trace
+from tests.support.workers import WorkerProcess
 
 USE_CASES = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples" / "use_cases"
 # Robot time runs fifty times faster: a 2 s tool wait takes 40 ms.

@@ -8,11 +8,11 @@ from pathlib import Path
 import pytest
 
 from hrc.cases.choices import CaseStatus
-from hrc.cases.launcher import WorkerProcess
 from hrc.cases.models import Case
 from hrc.cases.simulation import Simulation
 from tests.cases.patterns import cobot_chain
 from tests.postgres import sessions_opened
+from tests.support.workers import WorkerProcess
 
 
 @pytest.mark.django_db(transaction=True)

@@ -9,7 +9,7 @@ import pytest
 from asyncua import Client
 
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
-from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
 from tests.cobots.simulator import PROGRAM
 
 

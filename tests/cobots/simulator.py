@@ -11,9 +11,9 @@ from typing import Any
 
 from asyncua import Client
 
-from hrc.cobots import urua
-from hrc.cobots.gateway.sim.backend import SimBackend
-from hrc.cobots.gateway.sim.robot import IDLE
+from hrc_gateway import urua
+from hrc_gateway.sim.backend import SimBackend
+from hrc_gateway.sim.robot import IDLE
 
 # Coexistence_PickAndPlace: 1 home, 2 move to a pose (ws 0 part box), 3 pick (a 2 s wait).
 PROGRAM = "Coexistence_PickAndPlace"

@@ -2,8 +2,8 @@ from django.test import Client
 
 from hrc.cobots import services
 from hrc.cobots.drivers.base import unreachable_message
-from hrc.cobots.gateway.launcher import GatewayProcess, free_port
 from hrc.cobots.models import Cobot
+from hrc.cobots.simulated import GatewayProcess, free_port
 from hrc.organisations.models import Organisation
 from tests import factories
 

@@ -17,13 +17,13 @@ from rest_framework.test import APIClient
 from hrc.cases import jobs
 from hrc.cases.choices import JobState
 from hrc.cases.models import Job
-from hrc.cobots import urua
 from hrc.cobots.choices import CommandOutcome
 from hrc.cobots.drivers.base import unreachable_message
 from hrc.cobots.drivers.runner import driver_for_cobot
-from hrc.cobots.gateway.launcher import GatewayProcess, free_port
 from hrc.cobots.models import Cobot, CobotCommand
+from hrc.cobots.simulated import GatewayProcess, free_port
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 from tests import factories
 from tests.cobots.simulator import PROGRAM, save_arm_powered_to_idle
 

@@ -21,11 +21,11 @@ from hrc.cobots import services
 from hrc.cobots.credentials import credentials_for
 from hrc.cobots.drivers.base import unreachable_message
 from hrc.cobots.drivers.runner import driver_for_cobot
-from hrc.cobots.endpoints import endpoint_key
-from hrc.cobots.gateway.launcher import free_port
 from hrc.cobots.models import Cobot, CredentialsSecret
 from hrc.cobots.selectors import live_state
+from hrc.cobots.simulated import free_port
 from hrc.organisations.models import Organisation
+from hrc_gateway.endpoints import endpoint_key
 from tests import factories
 
 # --- One gateway, one cobot ------------------------------------------------------------

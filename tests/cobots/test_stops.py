@@ -10,9 +10,10 @@ from django.contrib.auth.models import User
 
 from hrc.cases.choices import InterruptionMode
 from hrc.cases.models import Interruption
-from hrc.cobots import hooks, stops, urua
+from hrc.cobots import hooks, stops
 from hrc.cobots.models import CellStop, Cobot
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 from tests import factories
 
 pytestmark = pytest.mark.django_db(transaction=True)

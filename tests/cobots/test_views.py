@@ -12,8 +12,8 @@ from django.contrib.auth.models import User
 from django.test import Client
 
 from hrc.cases import jobs
-from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import Cobot, CobotCommand
+from hrc.cobots.simulated import GatewayProcess
 from hrc.organisations.models import AdminRecord, Cell, Organisation
 from tests import factories
 from tests.cobots.simulator import PROGRAM

@@ -28,8 +28,9 @@ from pathlib import Path
 from typing import Any, Self
 from urllib.parse import urlsplit, urlunsplit
 
-from hrc.cobots.gateway.launcher import ROOT, free_port
-from hrc.patterns.management.commands.demo import SERVING
+from hrc.cobots.simulated import free_port
+from hrc.demo.management.commands.demo import SERVING
+from tests.support.paths import ROOT
 
 PASSWORD_LINE = re.compile(r"^\s+(\S+)\s+password (\S+)\s", re.MULTILINE)
 STARTED_LINE = re.compile(r"^\s+(.+): case (\d+)\s+http", re.MULTILINE)

@@ -25,14 +25,15 @@ from pathlib import Path
 import pytest
 from websockets.asyncio.client import connect
 
-from hrc.cases.launcher import RedisProcess
-from hrc.cobots import urua
 from hrc.cobots.drivers.runner import driver_for
-from hrc.cobots.gateway.launcher import ROOT, free_port
+from hrc.cobots.simulated import free_port
+from hrc.demo.management.commands.demo import PREPARED
 from hrc.demo.organisation import PERSONAS
 from hrc.demo.plant import STARTED_CASES
-from hrc.patterns.management.commands.demo import PREPARED
+from hrc_gateway import urua
 from tests.demo.rig import Browserless, DemoRun, alive, scratch_postgres
+from tests.support.paths import ROOT
+from tests.support.workers import RedisProcess
 
 CONFIG = re.compile(r'<script id="tablet-config" type="application/json">(.*?)</script>', re.S)
 

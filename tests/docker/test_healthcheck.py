@@ -12,11 +12,12 @@ from pathlib import Path
 import pytest
 from django.db import connection
 
-from hrc.cases.launcher import RedisProcess, WorkerProcess
-from hrc.cobots.gateway.launcher import ROOT, GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.live.server import LiveServer, MonitorProcess
+from tests.support.paths import ROOT
+from tests.support.workers import RedisProcess, WorkerProcess
 
 
 def _check(*arguments: str, environment: dict[str, str] | None = None) -> tuple[int, str]:

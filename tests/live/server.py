@@ -21,7 +21,7 @@ from django.contrib.auth.models import User
 from django.db import connection
 from django.test import Client
 
-from hrc.cobots.gateway.launcher import free_port
+from hrc.cobots.simulated import free_port
 
 
 class _ManagePy:

@@ -14,14 +14,15 @@ import pytest
 from django.contrib.auth.models import User
 from rest_framework.test import APIClient
 
-from hrc.cobots import stops, urua
+from hrc.cobots import stops
 from hrc.cobots.drivers.base import Fence, StepCommand
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
-from hrc.cobots.gateway.launcher import GatewayProcess
 from hrc.cobots.models import CellStop, Cobot
+from hrc.cobots.simulated import GatewayProcess
 from hrc.live.consumers import STATE_INTERVAL
 from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
+from hrc_gateway import urua
 from tests import factories
 from tests.cobots.simulator import PROGRAM
 from tests.live.client import db, open_socket, receive, receive_until, run

@@ -14,7 +14,7 @@ import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from hrc.cobots import urua
+from hrc_gateway import urua
 
 
 class DriverError(Exception):

@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, Final
 
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import (
     CobotNotReady,
     CobotStarting,
@@ -22,6 +21,7 @@ from hrc.cobots.drivers.base import (
     CobotUnreachable,
     DriverError,
 )
+from hrc_gateway import urua
 
 # On its way to Idle or Running by itself: a retry a little later may find it ready.
 STARTING_MODES: Final = frozenset({"Booting", "Power On"})

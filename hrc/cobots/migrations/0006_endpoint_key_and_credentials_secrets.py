@@ -5,7 +5,7 @@ import hrc.cobots.validators
 from django.conf import settings
 from django.db import migrations, models
 
-from hrc.cobots.endpoints import EndpointError, endpoint_key
+from hrc_gateway.endpoints import EndpointError, endpoint_key
 
 
 def fill_endpoint_keys(apps, schema_editor):
@@ -49,7 +49,7 @@ class Migration(migrations.Migration):
         migrations.AddField(
             model_name='cobot',
             name='endpoint_key',
-            field=models.CharField(editable=False, help_text="The endpoint as the network sees it (hrc.cobots.endpoints.endpoint_key); unique, so one gateway is one cobot's. Empty only for a cobot that shared its endpoint before the rule.", max_length=600, null=True),
+            field=models.CharField(editable=False, help_text="The endpoint as the network sees it (hrc_gateway.endpoints.endpoint_key); unique, so one gateway is one cobot's. Empty only for a cobot that shared its endpoint before the rule.", max_length=600, null=True),
         ),
         migrations.AlterField(
             model_name='cobot',

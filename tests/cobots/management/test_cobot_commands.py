@@ -9,7 +9,7 @@ import pytest
 from django.core.management import CommandError, call_command
 
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
-from hrc.cobots.gateway.launcher import GatewayProcess, free_port
+from hrc.cobots.simulated import GatewayProcess, free_port
 from hrc.organisations.models import Organisation
 from tests import factories
 

@@ -27,7 +27,6 @@ from typing import Any
 from asyncua import Client, Node, ua
 from asyncua.common.methods import call_method_full
 
-from hrc.cobots import urua
 from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
     NO_FENCE,
@@ -46,8 +45,9 @@ from hrc.cobots.drivers.base import (
     StepTimeout,
     unreachable_message,
 )
-from hrc.cobots.endpoints import EndpointError, IPNetwork, check_networks
-from hrc.cobots.pki import PkiError, check_gateway_certificate, secure_client
+from hrc_gateway import urua
+from hrc_gateway.endpoints import EndpointError, IPNetwork, check_networks
+from hrc_gateway.pki import PkiError, check_gateway_certificate, secure_client
 
 logger = logging.getLogger(__name__)
 
@@ -102,7 +102,7 @@ _CONNECTION_ERRORS = (OSError, ConnectionError, asyncio.TimeoutError, ua.UaError
 
 @dataclass(frozen=True)
 class ClientSecurity:
-    """How the driver proves itself to a secured gateway (see hrc.cobots.pki)."""
+    """How the driver proves itself to a secured gateway (see hrc_gateway.pki)."""
 
     pki_dir: Path
     username: str

@@ -2,7 +2,7 @@
 [--user NAME --password-env VAR] [--force]`
 
 Creates what the named gateways and the driver lack to talk securely (see
-`hrc.cobots.pki` for the layout): the driver's certificate once, each
+`hrc_gateway.pki` for the layout): the driver's certificate once, each
 gateway's certificate, the mutual trust, and optionally a gateway user.
 Run it again at will: it keeps what exists and re-pins each gateway's
 current certificate. It replaces a gateway's certificate only with --force;
@@ -22,7 +22,7 @@ from typing import Any
 from django.conf import settings
 from django.core.management.base import BaseCommand, CommandError, CommandParser
 
-from hrc.cobots import pki
+from hrc_gateway import pki
 
 
 class Command(BaseCommand):

@@ -13,9 +13,9 @@ from typing import Any
 
 from django.core.management.base import CommandError, CommandParser
 
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import DriverError, Fence, StepCommand
 from hrc.cobots.management.commands._cobot_command import CobotCommand
+from hrc_gateway import urua
 
 
 class Command(CobotCommand):

@@ -8,7 +8,6 @@ import time
 import pytest
 from asyncua import Client, ua
 
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import (
     CobotNotReady,
     CobotStopped,
@@ -21,7 +20,8 @@ from hrc.cobots.drivers.base import (
     unreachable_message,
 )
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
-from hrc.cobots.gateway.launcher import GatewayProcess, free_port
+from hrc.cobots.simulated import GatewayProcess, free_port
+from hrc_gateway import urua
 from tests.cobots.simulator import executions, read, until
 
 # Coexistence_PickAndPlace: 1 home, 2 move to a pose in the part box (ws 0), 3 pick (2 s wait).

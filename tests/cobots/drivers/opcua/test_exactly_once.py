@@ -16,11 +16,12 @@ from pathlib import Path
 
 from asyncua import Client, ua
 
-from hrc.cobots import urua
 from hrc.cobots.drivers.base import Fence, StepCommand
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
-from hrc.cobots.gateway.launcher import ROOT, GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
+from hrc_gateway import urua
 from tests.cobots.simulator import PROGRAM, executed_steps, executions, read, until
+from tests.support.paths import ROOT
 
 PICK = 3  # Coexistence_PickAndPlace: a 2 s (simulated) pick
 IN_BIT = urua.register_path("Inputs", "Bit64")

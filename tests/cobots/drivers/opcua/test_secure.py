@@ -11,7 +11,7 @@ from django.core.management import call_command
 
 from hrc.cobots.drivers.base import CobotUnreachable, Fence, StepCommand, unreachable_message
 from hrc.cobots.drivers.opcua.driver import ClientSecurity, OpcUaDriver
-from hrc.cobots.gateway.launcher import GatewayProcess
+from hrc.cobots.simulated import GatewayProcess
 from tests.cobots.simulator import PROGRAM
 
 PASSWORD = "correct horse battery staple"

@@ -1,0 +1,1 @@
+"""What the tests and the benchmark share: processes they start (workers, Redis) and paths."""
