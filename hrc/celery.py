@@ -5,6 +5,9 @@ from typing import Any
 
 from celery import Celery
 from celery.signals import task_postrun, task_prerun, worker_process_init, worker_ready
+from django.db import close_old_connections
+
+from hrc.process import freeze_start_up
 
 os.environ.setdefault("DJANGO_SETTINGS_MODULE", "hrc.settings.dev")
 
@@ -22,8 +25,6 @@ def _close_old_connections(task: Any = None, **kwargs: Any) -> None:
     """
     if getattr(getattr(task, "request", None), "is_eager", False):
         return
-    from django.db import close_old_connections
-
     close_old_connections()
 
 
@@ -34,8 +35,6 @@ task_postrun.connect(_close_old_connections)
 def _freeze_start_up(**kwargs: Any) -> None:
     """The worker's main process, which takes the messages from the broker, once ready, and
     each pool child once forked and set up (hrc/process.py)."""
-    from hrc.process import freeze_start_up
-
     freeze_start_up()
 
 

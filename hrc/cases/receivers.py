@@ -1,9 +1,11 @@
 """The cases app's answers to the inner apps' hooks, registered when Django is ready (apps.py)."""
 
-# The tasks, registered with the Celery app: dispatch finds them by name to run them inline.
-import hrc.cases.tasks
-import hrc.celery  # noqa: F401  (the Celery app, so tasks sent from a web process use the configured broker)
-from hrc.cases import interruptions, selectors, services
+from hrc.cases import (
+    interruptions,
+    selectors,
+    services,
+    tasks,  # noqa: F401  (registers them, so dispatch finds them by name inline)
+)
 from hrc.cobots import hooks as cobot_hooks
 from hrc.organisations import hooks as organisation_hooks
 
