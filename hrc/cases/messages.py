@@ -18,11 +18,11 @@ from django.db import IntegrityError, transaction
 from django.utils import timezone
 
 from hrc.cases.choices import CaseStatus, EventType
-from hrc.cases.errors import Conflict, Invalid
 from hrc.cases.models import Case, Message
 from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, correlates
+from hrc.errors import Conflict, Invalid
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
 

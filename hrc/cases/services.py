@@ -6,7 +6,7 @@ one case at once; the engine's CaseNet decides what the marking allows.
 Lock order, everywhere: cobot row, then case row, then job row, then
 interruption row. Broadcast and dispatch happen after commit (dispatch.py).
 
-Errors: CaseError subclasses, each with the HTTP status the API answers:
+Errors: Refusal subclasses, each with the HTTP status the API answers:
 Conflict (409: the case or work item has moved on), NotAllowed (403: not
 this user's task), Invalid (400: the input is wrong).
 """
@@ -34,7 +34,6 @@ from hrc.cases.choices import (
     WorkItemKind,
     WorkItemState,
 )
-from hrc.cases.errors import Conflict, Invalid, NotAllowed, NotFound
 from hrc.cases.mapping import resolve_actor_mapping
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
@@ -42,6 +41,7 @@ from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, resolve
 from hrc.engine.startdata import check_start_data
 from hrc.engine.taskconfig import POSE_LENGTH, TaskConfig
+from hrc.errors import Conflict, Invalid, NotAllowed, NotFound
 from hrc.live import broadcast as live
 from hrc.patterns.models import PatternVersion
 
