@@ -47,7 +47,7 @@ from tests.browser.drawing import (
     select_element,
 )
 from tests.demo.rig import DemoRun, scratch_postgres
-from tests.polling import until
+from tests.support.polling import until
 
 Screenshot = Callable[[Page, str], Path]
 LIVE_MS = 60_000

@@ -29,7 +29,7 @@ from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PICK, func_hold
-from tests.polling import until
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

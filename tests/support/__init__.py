@@ -1,0 +1,1 @@
+"""What the tests and the bench share: waiting, and the programs they start."""
