@@ -51,6 +51,7 @@ lint: install  ## ruff, mypy and tsc
 	.venv/bin/ruff check .
 	.venv/bin/ruff format --check .
 	.venv/bin/mypy hrc tests bench
+	.venv/bin/lint-imports
 	cd frontend && npx tsc --noEmit
 
 $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
