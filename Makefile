@@ -51,6 +51,7 @@ lint: install  ## ruff, mypy, tsc, ESLint, the import contracts, the docs build
 	.venv/bin/ruff check .
 	.venv/bin/ruff format --check .
 	.venv/bin/mypy hrc hrc_gateway tests bench
+	.venv/bin/lint-imports
 	cd frontend && npx tsc --noEmit
 	cd frontend && npx eslint .
 	NO_MKDOCS_2_WARNING=1 .venv/bin/mkdocs build --strict --quiet  # docs/ into site/ (ignored)

@@ -48,6 +48,7 @@ from bench.runtime_rig import (
     scratch_database,
     summary,
 )
+from tests.support.polling import until
 
 TARGET_P99_MS = 100.0
 PROGRAM, STEP = "Coexistence_PickAndPlace", 3  # "pick": a 2 s wait
@@ -302,7 +303,7 @@ def measure_ours(bench: Rig, settings: Settings, progress: Callable[[str], None]
         bench.tablets.expect(_offers_the_operator_task)
         case = services.start_case(bench.version, started_by=None)
         jobs = Job.objects.filter(case=case).values_list("pk", flat=True)
-        job_id = _until(jobs.first)
+        job_id = until(jobs.first, interval=0.001)
         applied = bench.tablets.wait()
         done = bench.observer.seen_at(urua.FENCE_STEP, job_id)
         if index >= settings.warmup:
@@ -326,16 +327,6 @@ def _offers_the_operator_task(event: dict[str, Any]) -> bool:
         and event["event"] == "task-offered"
         and event["item"]["task"] == "to1"
     )
-
-
-def _until(condition: Callable[[], Any], timeout: float = 30.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.001)
-    raise TimeoutError("condition not reached in time")
 
 
 def _is_case(marker: int) -> Callable[[dict[str, Any]], bool]:

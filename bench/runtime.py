@@ -64,6 +64,7 @@ from bench.runtime_rig import (
     rig,
     summary,
 )
+from tests.support.polling import until
 
 if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the functions
     from django.contrib.auth.models import User
@@ -277,17 +278,19 @@ def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 
     from hrc.cases.models import Case, Incident
 
     cases = Case.objects.filter(pk__range=(first, last))
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+
+    def completed() -> bool:
         if not cases.filter(status__in=OPEN_CASE_STATUSES).exists():
             ended = cases.exclude(status=CaseStatus.COMPLETED).first()
             if ended is None:
-                return
+                return True
             raise RuntimeError(f"Case {ended.pk} ended {ended.status}, not completed.")
         incident = Incident.objects.filter(case__in=cases, resolved_at__isnull=True).first()
         if incident is not None:
             raise RuntimeError(f"Case {incident.case_id}: {incident.kind}: {incident.message}")
-        time.sleep(poll)
+        return False
+
+    until(completed, timeout, poll, f"Cases still open after {timeout:.0f} s.")
     raise TimeoutError(f"Cases still open after {timeout:.0f} s.")
 
 
@@ -348,11 +351,12 @@ def _celery_rate(bench: Rig, count: int) -> tuple[float, float]:
         roles = [*worker.pids(), *([bench.redis.process.pid] if bench.redis.process else [])]
         meter = _processes_meter("celery", roles)
         _control(floor_app.control.add_consumer, FLOOR_QUEUE, [worker.node])
-        deadline = time.monotonic() + 600
-        while client.llen(key) < count:
-            if time.monotonic() > deadline:
-                raise RuntimeError("The floor worker did not run its tasks within 10 minutes.")
-            time.sleep(0.05)
+        until(
+            lambda: client.llen(key) >= count,
+            600,
+            0.05,
+            "The floor worker did not run its tasks within 10 minutes.",
+        )
         cpu = meter.stop()
     finally:
         worker.stop()

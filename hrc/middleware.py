@@ -1,4 +1,5 @@
-"""The project's own middleware: a policy header on every response, a 503 for a database that is down.
+"""The project's own middleware: a policy header on every response, a 503 for a database that is
+down, and the pages' answer to a refusal (hrc.errors).
 
 A database that cannot be reached answers 503 with a message, never a 500 with a traceback.
 
@@ -20,7 +21,10 @@ from typing import Any
 from django.conf import settings
 from django.db import InterfaceError, OperationalError
 from django.http import HttpRequest, HttpResponse, JsonResponse
+from django.shortcuts import render
 from django.template.loader import render_to_string
+
+from hrc.errors import Refusal
 
 logger = logging.getLogger(__name__)
 View = Callable[..., HttpResponse]
@@ -50,6 +54,33 @@ class DatabaseUnavailableMiddleware:
             # Rendered without the request: its context processors would ask the database again.
             response = HttpResponse(render_to_string("503.html", {"detail": DETAIL}), status=503)
         response["Retry-After"] = str(RETRY_AFTER_SECONDS)
+        return response
+
+
+class RefusalMiddleware:
+    """Answers a refusal a page view lets through: the refused page with its message and status.
+
+    The API's views answer theirs in DRF (hrc.api.exceptions), so none arrives here
+    from them; a plain Django view under /api/ gets the same JSON body.
+    """
+
+    def __init__(self, get_response: Callable[[HttpRequest], HttpResponse]) -> None:
+        self.get_response = get_response
+
+    def __call__(self, request: HttpRequest) -> HttpResponse:
+        return self.get_response(request)
+
+    def process_exception(self, request: HttpRequest, exception: Exception) -> HttpResponse | None:
+        if not isinstance(exception, Refusal):
+            return None
+        response: HttpResponse
+        if request.path.startswith("/api/"):
+            response = JsonResponse(exception.body(), status=exception.status)
+        else:
+            context = {"message": str(exception)}
+            response = render(request, "refused.html", context, status=exception.status)
+        for name, value in exception.headers().items():
+            response[name] = value
         return response
 
 

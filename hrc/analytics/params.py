@@ -1,7 +1,8 @@
 """The query parameters of the analytics pages and API, read once for both.
 
 Each reader returns None when the parameter is absent and raises BadParameter,
-whose message names the parameter and what it must be, for anything else.
+whose message names the parameter and what it must be, for anything else; the
+API and the pages answer it as they answer every refusal (hrc.errors).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from django.utils import timezone
 from django.utils.dateparse import parse_date, parse_datetime
 
 from hrc.analytics.xes import LIFECYCLES, Lifecycle
+from hrc.errors import Invalid
 
 ID = re.compile(r"[0-9]{1,18}")  # fits a bigint primary key
 # Real zones lie within UTC-12 and UTC+14; PostgreSQL refuses an offset past ±15:59, which
@@ -24,11 +26,13 @@ EARLIEST = dt.datetime(1, 1, 2, tzinfo=dt.UTC)
 LATEST = dt.datetime(9999, 12, 30, tzinfo=dt.UTC)
 
 
-class BadParameter(ValueError):
-    """A query parameter the request cannot mean; its message names it."""
+class BadParameter(Invalid):
+    """A query parameter the request cannot mean (400); its message names it, as `parameter` does."""
+
+    code = "bad-parameter"
 
     def __init__(self, name: str, message: str) -> None:
-        super().__init__(message)
+        super().__init__(message, extra={"parameter": name})
         self.name = name
 
 

@@ -2,7 +2,8 @@
 
 Server-rendered (the chart is an SVG drawn by hrc.analytics.gantt), for
 engineers and admins behind the organisation wall like the supervisor pages:
-another organisation's version or case is a 404, an operator gets 403. The
+another organisation's version or case is a 404, an operator gets 403 (a
+refusal of hrc.errors, which hrc.middleware.RefusalMiddleware renders). The
 XES download is the API's (/api/analytics/xes/), which the session signs in to.
 """
 
@@ -21,6 +22,7 @@ from django.utils import timezone
 from hrc.analytics import params, selectors
 from hrc.analytics.gantt import ConstraintRow, draw_gantt
 from hrc.cases.models import Case
+from hrc.errors import NotAllowed
 from hrc.organisations.selectors import may_write_in, writable_organisations
 from hrc.patterns.models import PatternVersion
 
@@ -36,24 +38,11 @@ class ConstraintLine:
     arrows: int
 
 
-class Refused(Exception):
-    """A request the page answers with a status and a message (400, 403)."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-
-
-def _refusal(request: HttpRequest, refused: Refused) -> HttpResponse:
-    context = {"message": str(refused)}
-    return render(request, "refused.html", context, status=refused.status)
-
-
 @login_required
 def version_list(request: HttpRequest) -> HttpResponse:
     """The published versions of the user's organisations, those with cases first."""
     if not writable_organisations(request.user).exists():
-        return _refusal(request, Refused(403, ANALYSTS_ONLY))
+        raise NotAllowed(ANALYSTS_ONLY)
     versions = selectors.analysed_versions(request.user)
     return render(request, "analytics/version_list.html", {"versions": versions})
 
@@ -62,13 +51,8 @@ def version_list(request: HttpRequest) -> HttpResponse:
 def version_detail(request: HttpRequest, pk: int) -> HttpResponse:
     """One version's figures: cycle times, tasks, operator waiting, cobots, interruptions;
     `?since=` and `?until=` narrow them to the cases that started in between."""
-    try:
-        version = _analysed_version(request, pk)
-        since, until = params.window(request.GET.get("since"), request.GET.get("until"))
-    except params.BadParameter as problem:
-        return _refusal(request, Refused(400, str(problem)))
-    except Refused as refused:
-        return _refusal(request, refused)
+    version = _analysed_version(request, pk)
+    since, until = params.window(request.GET.get("since"), request.GET.get("until"))
     now = timezone.now()
     figures = selectors.version_analytics(version, now=now, since=since, until=until)
     window = {key: value for key, value in (("since", since), ("until", until)) if value}
@@ -88,10 +72,7 @@ def version_detail(request: HttpRequest, pk: int) -> HttpResponse:
 @login_required
 def case_gantt(request: HttpRequest, pk: int) -> HttpResponse:
     """One case as a Gantt chart, with its bars as a table below."""
-    try:
-        case = _analysed_case(request, pk)
-    except Refused as refused:
-        return _refusal(request, refused)
+    case = _analysed_case(request, pk)
     drawing = draw_gantt(selectors.case_gantt(case, now=timezone.now()), width=GANTT_WIDTH)
     rows = sorted(drawing.bars, key=lambda b: (b.bar.offered_at, b.bar.work_item))
     arrows = Counter(arrow.constraint for arrow in drawing.gantt.arrows)
@@ -112,7 +93,7 @@ def _analysed_version(request: HttpRequest, pk: int) -> PatternVersion:
     if version is None:
         raise Http404("No such version.")
     if not may_write_in(request.user, version.pattern.organisation_id):
-        raise Refused(403, ANALYSTS_ONLY)
+        raise NotAllowed(ANALYSTS_ONLY)
     return version
 
 
@@ -121,5 +102,5 @@ def _analysed_case(request: HttpRequest, pk: int) -> Case:
     if case is None:
         raise Http404("No such case.")
     if not may_write_in(request.user, case.organisation_id):
-        raise Refused(403, ANALYSTS_ONLY)
+        raise NotAllowed(ANALYSTS_ONLY)
     return case

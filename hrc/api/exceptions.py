@@ -1,10 +1,11 @@
 """One error format for the whole API: `{"detail": str, ...}` with a 4xx status.
 
 DRF already turns its own exceptions into 4xx; this adds the Django, engine and
-case-service ones a view can raise (a request body over the size limit, a model
-rule, a document that is not `hrc-pattern/1`, a CaseError with its status) so
-that bad input never reaches the client as a 500 with a traceback. Field
-errors keep DRF's shape under `fields`.
+service ones a view can raise (a request body over the size limit, a model
+rule, a document that is not `hrc-pattern/1`, any refusal of `hrc.errors` with
+its status and code) so that bad input never reaches the client as a 500 with a
+traceback, and no view catches a service's refusal itself. Field errors keep
+DRF's shape under `fields`.
 """
 
 from typing import Any
@@ -13,11 +14,12 @@ from django.core.exceptions import RequestDataTooBig, SuspiciousOperation
 from django.core.exceptions import ValidationError as DjangoValidationError
 from django.db.models import ProtectedError
 from rest_framework import exceptions, status
+from rest_framework.exceptions import Throttled
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
-from hrc.cases.errors import CaseError, Invalid
 from hrc.engine import FormatError
+from hrc.errors import Busy, Refusal
 
 
 class Rejected(exceptions.APIException):
@@ -57,11 +59,8 @@ def exception_handler(exc: Exception, context: dict[str, Any]) -> Response | Non
         return Response({"detail": str(exc)}, status=status.HTTP_400_BAD_REQUEST)
     if isinstance(exc, FormatError):
         exc = document_rejected(exc)
-    if isinstance(exc, CaseError):  # Invalid 400, NotAllowed 403, Conflict 409
-        body: dict[str, Any] = {"detail": str(exc)}
-        if isinstance(exc, Invalid) and exc.fields:
-            body["fields"] = exc.fields
-        return Response(body, status=exc.status)
+    if isinstance(exc, Refusal):
+        return refusal_response(exc, context)
     if isinstance(exc, Rejected):
         return Response(exc.payload, status=exc.status_code)
     if isinstance(exc, DjangoValidationError):
@@ -76,6 +75,19 @@ def exception_handler(exc: Exception, context: dict[str, Any]) -> Response | Non
     if response is not None and isinstance(exc, exceptions.ValidationError):
         response.data = _with_summary(response.data)
     return response
+
+
+def refusal_response(refusal: Refusal, context: dict[str, Any]) -> Response:
+    """The refusal's body with its status and headers; `{"detail", "code", ...}`."""
+    if isinstance(refusal, Busy):
+        # DRF's own 429, whose detail also says when to try again, as throttling answers.
+        throttled = drf_exception_handler(
+            Throttled(wait=refusal.retry_after, detail=str(refusal)), context
+        )
+        assert throttled is not None  # DRF answers every APIException
+        throttled.data["code"] = refusal.code
+        return throttled
+    return Response(refusal.body(), status=refusal.status, headers=refusal.headers())
 
 
 # Where DRF and Django put errors that belong to no single field.

@@ -16,8 +16,8 @@ from django.db.models import QuerySet
 from django.http import HttpRequest
 
 from hrc.cases import services
-from hrc.cases.errors import CaseError
 from hrc.cases.models import Case, CaseEvent, Incident, Job, Message, WorkItem
+from hrc.errors import Refusal
 
 # Generic for mypy only: Django's runtime classes are not subscriptable.
 if TYPE_CHECKING:
@@ -66,7 +66,7 @@ def _steer(
             try:
                 change(case, request.user)
                 done += 1
-            except CaseError as refused:
+            except Refusal as refused:
                 modeladmin.message_user(request, f"Case {case.pk}: {refused}", messages.WARNING)
         if done:
             modeladmin.message_user(request, f"{done} case(s) {verb}.", messages.SUCCESS)

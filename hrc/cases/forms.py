@@ -12,11 +12,11 @@ from typing import Any
 from django import forms
 from django.contrib.auth.models import User
 
-from hrc.cases.errors import Invalid
 from hrc.cases.services import MAX_CASES_AT_ONCE
 from hrc.cobots.models import Cobot
 from hrc.engine.model import Pattern
 from hrc.engine.startdata import StartField, start_fields
+from hrc.errors import Invalid
 from hrc.organisations.models import Organisation, Team
 
 YES_NO = [("", "Choose…"), ("yes", "Yes"), ("no", "No")]

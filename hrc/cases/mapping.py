@@ -10,9 +10,9 @@ from typing import Any
 
 from django.contrib.auth import get_user_model
 
-from hrc.cases.errors import Invalid
 from hrc.cobots.models import Cobot
 from hrc.engine.model import Pattern
+from hrc.errors import Invalid
 from hrc.organisations.models import Organisation, Team
 
 

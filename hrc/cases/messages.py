@@ -19,9 +19,9 @@ from django.utils import timezone
 
 from hrc.cases import progress
 from hrc.cases.choices import CaseStatus
-from hrc.cases.errors import Conflict, Invalid
 from hrc.cases.models import Case, Message
 from hrc.cases.nets import case_net
+from hrc.errors import Conflict, Invalid
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
 

@@ -2,10 +2,10 @@
 
 from functools import lru_cache
 
-from hrc.cases.errors import Invalid
 from hrc.engine.document import read_pattern
 from hrc.engine.runtime import CaseNet
 from hrc.engine.taskconfig import ConfigError
+from hrc.errors import Invalid
 from hrc.patterns.models import PatternVersion
 
 

@@ -32,7 +32,6 @@ from hrc.cases.choices import (
     WorkItemState,
 )
 from hrc.cases.dispatch import Task
-from hrc.cases.errors import Conflict, Invalid, NotAllowed, NotFound
 from hrc.cases.events import open_incident, record_event
 from hrc.cases.models import Case, Incident, Interruption, Job, Message, WorkItem
 from hrc.cases.selectors import performable_by
@@ -40,6 +39,7 @@ from hrc.engine.commands import cobot_command
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, correlates
 from hrc.engine.taskconfig import TaskConfig
+from hrc.errors import Conflict, Invalid, NotAllowed, NotFound
 
 # advance() repeats settle → messages → held completions until nothing changes;
 # each round consumes a token or a message, so a sound net stops long before this.

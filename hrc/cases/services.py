@@ -1,7 +1,7 @@
 """The public commands on a case: lock, check, then progress (the firing rule on the rows).
 
 Each holds the case row lock for its whole transaction, so two tablets, a worker and a
-message never change one case at once. Refusals are CaseErrors with the HTTP status the
+message never change one case at once. Refusals belong to hrc.errors' family, each with the HTTP status the
 API answers: Conflict (409, it has moved on), NotAllowed (403), Invalid (400).
 """
 
@@ -24,7 +24,6 @@ from hrc.cases.choices import (
     WorkItemKind,
     WorkItemState,
 )
-from hrc.cases.errors import Conflict, Invalid
 from hrc.cases.events import record_event
 from hrc.cases.mapping import resolve_actor_mapping
 from hrc.cases.models import Case, Incident, WorkItem
@@ -34,6 +33,7 @@ from hrc.cases.selectors import performers_of
 from hrc.engine.forms import form_problems
 from hrc.engine.runtime import NotEnabled
 from hrc.engine.startdata import check_start_data
+from hrc.errors import Conflict, Invalid
 from hrc.patterns.models import PatternVersion
 
 # A start form's "count": enough for a shift's batch, not a load test by accident.

@@ -50,13 +50,13 @@ from django.utils import timezone
 
 from hrc.cases import dispatch, jobs, services
 from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus, WorkItemKind, WorkItemState
-from hrc.cases.errors import CaseError
 from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.models import Cobot
 from hrc.cobots.simulated import GatewayProcess
 from hrc.engine.model import Pattern
+from hrc.errors import Refusal
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
 from hrc.patterns import services as pattern_services
@@ -347,7 +347,7 @@ class Simulation:
             user = next((users[c.pk] for c in item.candidates.all() if c.pk in users), None)
             if user is None:
                 continue
-            with contextlib.suppress(CaseError):  # withdrawn or held meanwhile: try again later
+            with contextlib.suppress(Refusal):  # withdrawn or held meanwhile: try again later
                 if item.state == WorkItemState.OFFERED:
                     services.start_work_item(item, user=user)
                     low, high = self.operator_delay

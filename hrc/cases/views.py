@@ -40,10 +40,10 @@ from hrc.cases.choices import (
     WorkItemState,
 )
 from hrc.cases.drawing import ConstraintLine, NetDrawing, Node, draw_net
-from hrc.cases.errors import Conflict, Invalid
 from hrc.cases.forms import MappingForm, StartForm, StartRightsForm
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
 from hrc.cases.nets import case_net
+from hrc.errors import Invalid, NotAllowed
 from hrc.organisations.choices import Role
 from hrc.organisations.selectors import cells_of, may_write_in, writable_organisations
 from hrc.patterns.models import PatternVersion
@@ -67,31 +67,16 @@ EVENT_NAMES = dict(EventType.choices)
 LIVE_SOCKET = "/ws/live/"
 
 
-class Refused(Exception):
-    """A request the page answers with a status and a message (400, 403)."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-
-
-def _refusal(request: HttpRequest, refused: Refused) -> HttpResponse:
-    return render(request, "refused.html", {"message": str(refused)}, status=refused.status)
-
-
 # Running cases -----------------------------------------------------------------------------
 
 
 @login_required
 def case_list(request: HttpRequest) -> HttpResponse:
     """The cases of the user's organisations, open ones by default; `?state=` filters."""
-    try:
-        _require_supervisor(request)
-        state = request.GET.get("state", "open")
-        if state not in STATE_FILTERS:
-            raise Refused(400, f"state must be one of {', '.join(STATE_FILTERS)}, not {state!r}.")
-    except Refused as refused:
-        return _refusal(request, refused)
+    _require_supervisor(request)
+    state = request.GET.get("state", "open")
+    if state not in STATE_FILTERS:
+        raise Invalid(f"state must be one of {', '.join(STATE_FILTERS)}, not {state!r}.")
     cases = selectors.supervised_cases(request.user)
     version = request.GET.get("version", "")
     if version.isascii() and version.isdigit() and len(version) <= 18:
@@ -109,7 +94,7 @@ def case_list(request: HttpRequest) -> HttpResponse:
 
 def _require_supervisor(request: HttpRequest) -> None:
     if not writable_organisations(request.user).exists():
-        raise Refused(403, SUPERVISORS_ONLY)
+        raise NotAllowed(SUPERVISORS_ONLY)
 
 
 # One case ----------------------------------------------------------------------------------
@@ -161,11 +146,8 @@ class InterruptionRow:
 @login_required
 def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
     """One case: its net with the marking, open tasks, incidents, interruptions and timeline."""
-    try:
-        case = _supervised_case(request, pk)
-        before = _seq_param(request, "before")
-    except Refused as refused:
-        return _refusal(request, refused)
+    case = _supervised_case(request, pk)
+    before = _seq_param(request, "before")
     drawing = _drawing(case.version.pk, case.version)
     items = list(
         selectors.work_items_visible_to(request.user).filter(
@@ -256,7 +238,7 @@ def _supervised_case(request: HttpRequest, pk: int) -> Case:
     if case is None:
         raise Http404("No such case.")
     if not may_write_in(request.user, case.organisation_id):
-        raise Refused(403, SUPERVISORS_ONLY)
+        raise NotAllowed(SUPERVISORS_ONLY)
     return case
 
 
@@ -265,7 +247,7 @@ def _seq_param(request: HttpRequest, name: str) -> int | None:
     if value is None:
         return None
     if not value.isascii() or not value.isdigit() or len(value) > 9:
-        raise Refused(400, f"{name} must be an event number (a whole number), not {value!r}.")
+        raise Invalid(f"{name} must be an event number (a whole number), not {value!r}.")
     return int(value)
 
 
@@ -363,10 +345,7 @@ def format_duration(seconds: float) -> str:
 @login_required
 def incident_list(request: HttpRequest) -> HttpResponse:
     """The unresolved incidents of the user's organisations' cases, newest first."""
-    try:
-        _require_supervisor(request)
-    except Refused as refused:
-        return _refusal(request, refused)
+    _require_supervisor(request)
     incidents = selectors.supervised_incidents(request.user)
     page = Paginator(incidents, INCIDENTS_PER_PAGE).get_page(request.GET.get("page"))
     script = {
@@ -395,10 +374,7 @@ def version_detail(request: HttpRequest, pk: int) -> HttpResponse:
     here (POST `form` = mapping, rights, retire or reinstate); each refusal is
     shown at its field and changes nothing.
     """
-    try:
-        version = _supervised_version(request, pk)
-    except Refused as refused:
-        return _refusal(request, refused)
+    version = _supervised_version(request, pk)
     pattern = case_net(version).pattern
     organisation = version.pattern.organisation
     posted = request.POST if request.method == "POST" else None
@@ -460,14 +436,11 @@ def version_detail(request: HttpRequest, pk: int) -> HttpResponse:
 def case_start(request: HttpRequest) -> HttpResponse:
     """The start form: `?version=` chosen, the mapping (the version's defaults, overridable for
     these cases), the start data, a reference and a count; all the cases start or none."""
-    try:
-        _require_supervisor(request)
-        version_id = request.GET.get("version", "")
-        if not version_id:
-            return _choose_version(request)
-        version = _supervised_version(request, _whole(version_id, "version"))
-    except Refused as refused:
-        return _refusal(request, refused)
+    _require_supervisor(request)
+    version_id = request.GET.get("version", "")
+    if not version_id:
+        return _choose_version(request)
+    version = _supervised_version(request, _whole(version_id, "version"))
     net = case_net(version)
     form = StartForm(
         request.POST if request.method == "POST" else None,
@@ -502,19 +475,14 @@ def case_start(request: HttpRequest) -> HttpResponse:
 @require_POST
 def case_control(request: HttpRequest, pk: int) -> HttpResponse:
     """Cancels (`action=cancel`, with `confirm`), suspends or resumes the case, then shows it."""
-    try:
-        case = _supervised_case(request, pk)
-        action = request.POST.get("action", "")
-        steer = CASE_ACTIONS.get(action)
-        if steer is None:
-            raise Refused(400, f"action must be one of {', '.join(CASE_ACTIONS)}, not {action!r}.")
-        if action == "cancel" and request.POST.get("confirm") != "yes":
-            raise Refused(400, "Tick 'Yes, cancel this case' to cancel it.")
-        steer(case, by=_user(request))
-    except Refused as refused:
-        return _refusal(request, refused)
-    except Conflict as conflict:
-        return _refusal(request, Refused(409, str(conflict)))
+    case = _supervised_case(request, pk)
+    action = request.POST.get("action", "")
+    steer = CASE_ACTIONS.get(action)
+    if steer is None:
+        raise Invalid(f"action must be one of {', '.join(CASE_ACTIONS)}, not {action!r}.")
+    if action == "cancel" and request.POST.get("confirm") != "yes":
+        raise Invalid("Tick 'Yes, cancel this case' to cancel it.")
+    steer(case, by=_user(request))
     return redirect("cases:case-detail", case.pk)
 
 
@@ -544,7 +512,7 @@ def _supervised_version(request: HttpRequest, pk: int) -> PatternVersion:
     if version is None:
         raise Http404("No such version.")
     if not may_write_in(request.user, version.pattern.organisation_id):
-        raise Refused(403, SUPERVISORS_ONLY)
+        raise NotAllowed(SUPERVISORS_ONLY)
     return version
 
 
@@ -556,7 +524,7 @@ def _saved(request: HttpRequest, version: PatternVersion, message: str) -> HttpR
 
 def _whole(value: str, name: str) -> int:
     if not value.isascii() or not value.isdigit() or len(value) > 18:
-        raise Refused(400, f"{name} must be an id (a whole number), not {value!r}.")
+        raise Invalid(f"{name} must be an id (a whole number), not {value!r}.")
     return int(value)
 
 

@@ -36,6 +36,7 @@ from hrc.cobots.drivers.base import (
 )
 from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
 from hrc.cobots.models import Cobot, CobotCommand
+from hrc.errors import Refusal
 from hrc_gateway import urua
 
 # Seconds a command may take: a UR powering on and releasing its brakes takes several.
@@ -58,16 +59,17 @@ METHODS: Final = {
 DIRECTIONS: Final = ("Inputs", "Outputs")
 
 
-class ControlError(Exception):
+class ControlError(Refusal):
     """A command or read that did not happen; `status` is the HTTP status the API answers.
 
     `record` is the command's row when it was recorded (None for a request
     refused before: unconfirmed, or naming no program).
     """
 
+    code = "control-failed"
+
     def __init__(self, message: str, status: int, record: CobotCommand | None = None) -> None:
-        super().__init__(message)
-        self.status = status
+        super().__init__(message, status=status)
         self.record = record
 
 

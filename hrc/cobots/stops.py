@@ -28,6 +28,7 @@ from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
 from hrc.cobots.models import CellStop, Cobot
+from hrc.errors import Conflict
 from hrc.organisations.models import Organisation
 from hrc_gateway import urua
 
@@ -35,10 +36,10 @@ from hrc_gateway import urua
 COMMAND_TIMEOUT = 5.0
 
 
-class StopError(Exception):
-    """A STOP or resume that cannot be done; `status` is the HTTP status the API answers."""
+class StopError(Conflict):
+    """A STOP or resume that cannot be done: 409, or 400 for a resume without its confirmation."""
 
-    status = 409
+    code = "stop-refused"
 
 
 def stop_cell(organisation: Organisation, cell: str, *, by: User) -> CellStop:
@@ -79,9 +80,7 @@ def resume_cell(organisation: Organisation, cell: str, *, by: User, confirmed: b
     A cobot that a protective or emergency stop holds is left as it is, and said so.
     """
     if not confirmed:
-        error = StopError("Resuming the cell needs a confirmation (confirm: true).")
-        error.status = 400
-        raise error
+        raise StopError("Resuming the cell needs a confirmation (confirm: true).", status=400)
     with transaction.atomic():
         stop = (
             CellStop.objects.select_for_update()

@@ -32,6 +32,7 @@ from hrc.cobots.selectors import (
     credentials_secrets_of,
     live_state,
 )
+from hrc.errors import NotAllowed
 from hrc.navigation import current_membership
 from hrc.organisations.choices import WRITER_ROLES, AdminAction, Role
 from hrc.organisations.selectors import may_write_in, writable_organisations
@@ -57,16 +58,12 @@ BUTTONS = [
 ]
 
 
-def _refused(request: HttpRequest, status: int, message: str) -> HttpResponse:
-    return render(request, "refused.html", {"message": message}, status=status)
-
-
 @login_required
 def cobot_list(request: HttpRequest) -> HttpResponse:
     """The cobots of the organisations the user is an engineer or admin of, with state and queue."""
     writable = writable_organisations(request.user)
     if not writable.exists():
-        return _refused(request, 403, ENGINEERS_ONLY)
+        raise NotAllowed(ENGINEERS_ONLY)
     cobots = list(
         cobots_visible_to(request.user).filter(organisation__in=writable).order_by("name", "id")
     )
@@ -87,7 +84,7 @@ def cobot_detail(request: HttpRequest, pk: int) -> HttpResponse:
     if cobot is None:
         raise Http404("No such cobot.")
     if not may_write_in(request.user, cobot.organisation_id):
-        return _refused(request, 403, ENGINEERS_ONLY)
+        raise NotAllowed(ENGINEERS_ONLY)
     state = live_state(cobot)
     problems: list[str] = []
     programs = _programs(cobot, problems) if state["reachable"] else []
@@ -112,7 +109,7 @@ def cobot_new(request: HttpRequest) -> HttpResponse:
     """Registers a cobot in the organisation the engineer or admin works in."""
     membership = current_membership(request)
     if membership is None or membership.role not in WRITER_ROLES:
-        return _refused(request, 403, ENGINEERS_ONLY)
+        raise NotAllowed(ENGINEERS_ONLY)
     form = CobotForm(request.POST or None, instance=Cobot(organisation=membership.organisation))
     if request.method == "POST" and form.is_valid():
         try:
@@ -135,7 +132,7 @@ def cobot_edit(request: HttpRequest, pk: int) -> HttpResponse:
     if cobot is None:
         raise Http404("No such cobot.")
     if not may_write_in(request.user, cobot.organisation_id):
-        return _refused(request, 403, ENGINEERS_ONLY)
+        raise NotAllowed(ENGINEERS_ONLY)
     tested = None
     if request.method == "POST" and "test" in request.POST:
         tested = live_state(cobot)
@@ -163,7 +160,7 @@ def credentials_secrets(request: HttpRequest) -> HttpResponse:
     deletes them. Nobody, the admin included, sees a password again."""
     membership = current_membership(request)
     if membership is None or membership.role != Role.ADMIN:
-        return _refused(request, 403, ADMINS_ONLY)
+        raise NotAllowed(ADMINS_ONLY)
     organisation = membership.organisation
     form = CredentialsSecretForm()
     problem = ""

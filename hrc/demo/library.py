@@ -18,10 +18,10 @@ from django.core.exceptions import ValidationError
 from django.db import transaction
 
 from hrc.cases import services as case_services
-from hrc.cases.errors import Invalid
 from hrc.cases.nets import case_net
 from hrc.cobots.models import Cobot
 from hrc.engine import FormatError
+from hrc.errors import Invalid
 from hrc.organisations.models import Organisation, Team
 from hrc.patterns import services as pattern_services
 from hrc.patterns.models import PatternModel, PatternVersion

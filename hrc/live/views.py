@@ -21,9 +21,9 @@ from django.views.decorators.csrf import ensure_csrf_cookie
 from django.views.decorators.http import require_POST
 
 from hrc.cases import services as case_services
-from hrc.cases.errors import Invalid
 from hrc.cases.forms import CycleForm
 from hrc.engine.startdata import defaults_of
+from hrc.errors import Invalid
 from hrc.live import selectors
 from hrc.live.selectors import Access
 from hrc.navigation import current_membership

@@ -22,6 +22,7 @@ from django.utils.encoding import force_str
 from django.utils.http import urlsafe_base64_decode
 from django.views.decorators.http import require_http_methods, require_POST
 
+from hrc.errors import NotAllowed
 from hrc.navigation import current_membership
 from hrc.organisations import hooks, selectors, services
 from hrc.organisations.choices import Role
@@ -38,15 +39,11 @@ ADMINS_ONLY = "Only the organisation's admins manage its people, teams and cells
 RECORDS_SHOWN = 10
 
 
-class _Refused(Exception):
-    pass
-
-
 def _admin_of(request: HttpRequest) -> Membership:
-    """The admin's membership in the organisation they work in; _Refused for anyone else."""
+    """The admin's membership in the organisation they work in; NotAllowed for anyone else."""
     membership = current_membership(request)
     if membership is None or membership.role != Role.ADMIN:
-        raise _Refused
+        raise NotAllowed(ADMINS_ONLY)
     return membership
 
 
@@ -62,20 +59,12 @@ def _page(
     return render(request, template, context, status=status)
 
 
-def _refused(request: HttpRequest) -> HttpResponse:
-    return render(request, "refused.html", {"message": ADMINS_ONLY}, status=403)
-
-
 def admins_only(view: Any) -> Any:
     """Signed in and an admin of the current organisation, which is passed to the view."""
 
     @login_required
     def wrapped(request: HttpRequest, *args: Any, **kwargs: Any) -> HttpResponse:
-        try:
-            membership = _admin_of(request)
-        except _Refused:
-            return _refused(request)
-        result: HttpResponse = view(request, membership, *args, **kwargs)
+        result: HttpResponse = view(request, _admin_of(request), *args, **kwargs)
         return result
 
     wrapped.__name__ = view.__name__

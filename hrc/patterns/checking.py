@@ -36,6 +36,7 @@ from django.conf import settings
 from django.db import DatabaseError, connection
 
 from hrc.engine.budget import Budget
+from hrc.errors import Busy
 from hrc.patterns.documents import Report
 from hrc.patterns.engine_workers import check_in_worker
 
@@ -44,15 +45,17 @@ from hrc.patterns.engine_workers import check_in_worker
 _LOCK_SPACE = 0x4852 << 40
 
 
-class EngineBusy(Exception):
-    """All of the organisation's engine slots are taken; try again in a few seconds."""
+class EngineBusy(Busy):
+    """All of the organisation's engine slots are taken; try again in a few seconds (429)."""
+
+    code = "engine-busy"
 
     def __init__(self, slots: int) -> None:
         super().__init__(
             f"Your organisation already runs {slots} checks, layouts or imports at once, "
-            "the most it may: try again in a few seconds."
+            "the most it may: try again in a few seconds.",
+            retry_after=max(1, round(settings.HRC_CHECK_SECONDS)),
         )
-        self.retry_after = max(1, round(settings.HRC_CHECK_SECONDS))
 
 
 def interactive_budget() -> Budget:

@@ -36,6 +36,7 @@ from hrc.engine.model import Pattern
 from hrc.engine.pnml import pattern_to_pnml, pnml_to_pattern
 from hrc.engine.rules import STRUCTURAL_CODES, check_rules
 from hrc.engine.tokengame import execution_net_json
+from hrc.errors import Invalid
 
 # Deeper than any real pattern document (about 6 levels, plus the editor's layout),
 # shallow enough that nothing downstream (json, jsonb, the serializers) recurses too far.
@@ -71,11 +72,17 @@ def starter_document(name: str) -> dict[str, Any]:
     }
 
 
-class NoExecutionNet(Exception):
-    """The document breaks structural rules, so it has no execution net; `issues` says which."""
+class NoExecutionNet(Invalid):
+    """The document breaks structural rules, so it has no execution net; `issues` says which (400)."""
+
+    code = "no-execution-net"
 
     def __init__(self, issues: list[Issue]) -> None:
-        super().__init__("; ".join(issue.message for issue in issues))
+        rules = "; ".join(issue.message for issue in issues)
+        super().__init__(
+            f"The model breaks structural rules, so it cannot be played: {rules}",
+            extra={"errors": [issue.as_dict() for issue in issues]},
+        )
         self.issues = issues
 
 

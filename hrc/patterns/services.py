@@ -6,8 +6,10 @@ check the data. Errors:
 
 - FormatError (from the engine): the draft is not `hrc-pattern/1` in shape;
 - django.core.exceptions.ValidationError: another field breaks the model's rules;
-- PublishRefused: the draft does not pass the check, with the report;
-- PatternHasVersions: a published pattern cannot be deleted.
+- PublishRefused (400): the draft does not pass the check, with the report;
+- PatternHasVersions (409): a published pattern cannot be deleted.
+
+The last two are refusals of hrc.errors, which the API and the pages answer themselves.
 """
 
 from collections.abc import Iterable
@@ -19,6 +21,7 @@ from django.db import transaction
 from django.db.models import Max
 from django.utils import timezone
 
+from hrc.errors import Conflict, Invalid
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import cells_of
@@ -35,16 +38,22 @@ from hrc.patterns.models import PatternModel, PatternVersion
 NAME_LENGTH = PatternModel._meta.get_field("name").max_length or 200
 
 
-class PublishRefused(Exception):
-    """The draft is not valid or not sound; `report` is the check that says why."""
+class PublishRefused(Invalid):
+    """The draft is not valid or not sound; `report` is the check that says why (400)."""
+
+    code = "check-failed"
 
     def __init__(self, report: Report) -> None:
-        super().__init__("The draft does not pass the check.")
+        super().__init__(
+            "The draft does not pass the check; see the report.", extra={"report": report}
+        )
         self.report = report
 
 
-class PatternHasVersions(Exception):
-    """The pattern has published versions, which are kept as the record cases run against."""
+class PatternHasVersions(Conflict):
+    """The pattern has published versions, which are kept as the record cases run against (409)."""
+
+    code = "pattern-has-versions"
 
 
 def create_pattern(

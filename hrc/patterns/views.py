@@ -19,6 +19,7 @@ from django.views.decorators.csrf import ensure_csrf_cookie
 from django.views.decorators.http import require_POST
 
 from hrc.engine.taskconfig import DEVICE_CALLS
+from hrc.errors import NotAllowed
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import may_write_in, writable_organisations
 from hrc.patterns.models import PatternModel, PatternVersion
@@ -72,7 +73,7 @@ def pattern_archive(request: HttpRequest, pk: int) -> HttpResponse:
     """Archives a pattern (`archive=1`) or brings it back (`archive=0`), then lists the patterns."""
     pattern = get_object_or_404(patterns_visible_to(request.user), pk=pk)
     if not may_write_in(request.user, pattern.organisation_id):
-        return _refused(request, 403, WRITERS_ONLY)
+        raise NotAllowed(WRITERS_ONLY)
     archive = request.POST.get("archive") == "1"
     archive_pattern(pattern, archived=archive)
     return redirect(f"{reverse('patterns:list')}{'' if archive else '?archived=1'}")
@@ -84,7 +85,7 @@ def pattern_new(request: HttpRequest) -> HttpResponse:
     """The editor on an empty model; it is created in `?organisation=` (or the writer's only one) when first saved."""
     organisation = _target_organisation(request)
     if organisation is None:
-        return _refused(request, 403, WRITERS_ONLY)
+        raise NotAllowed(WRITERS_ONLY)
     config = {
         "pattern": {
             "id": None,
@@ -103,7 +104,7 @@ def pattern_edit(request: HttpRequest, pk: int) -> HttpResponse:
     """The editor on a pattern's draft."""
     pattern = get_object_or_404(patterns_visible_to(request.user), pk=pk)
     if not may_write_in(request.user, pattern.organisation_id):
-        return _refused(request, 403, WRITERS_ONLY)
+        raise NotAllowed(WRITERS_ONLY)
     config = {
         "pattern": {
             "id": pattern.pk,
@@ -133,7 +134,3 @@ def _editor(request: HttpRequest, config: dict[str, Any], title: str) -> HttpRes
         name: list(arguments) for name, (_, arguments, _) in DEVICE_CALLS.items()
     }
     return render(request, "patterns/editor.html", {"config": config, "title": title})
-
-
-def _refused(request: HttpRequest, status: int, message: str) -> HttpResponse:
-    return render(request, "refused.html", {"message": message}, status=status)

@@ -54,6 +54,7 @@ MIDDLEWARE = [
     "django.contrib.auth.middleware.AuthenticationMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
+    "hrc.middleware.RefusalMiddleware",
     "hrc.middleware.DatabaseUnavailableMiddleware",
     # Last, as axes asks: it turns a lockout into its 429 page.
     "axes.middleware.AxesMiddleware",

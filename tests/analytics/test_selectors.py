@@ -15,7 +15,7 @@ from hrc.cases.choices import CaseStatus
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
 from tests.cases.patterns import cobot_chain
-from tests.polling import until
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

@@ -30,6 +30,7 @@ from hrc.demo.plant import STARTED_CASES
 from tests.browser.conftest import TABLET
 from tests.demo.rig import DemoRun, alive, scratch_postgres
 from tests.support.paths import ROOT
+from tests.support.polling import until
 from tests.support.workers import RedisProcess
 
 Screenshot = Callable[[Page, str], Path]
@@ -103,8 +104,11 @@ def test_an_operator_completes_a_started_use_case_on_make_demo_and_ctrl_c_ends_e
         _complete(page, card, {})
 
     engineer = demo.token("engineer")
-    case = _until(
-        lambda: demo.get(engineer, f"/api/cases/{fixture}/"), lambda c: c["status"] != "running"
+    case = until(
+        lambda: _ended(demo.get(engineer, f"/api/cases/{fixture}/")),
+        timeout=60,
+        interval=0.5,
+        message=f"case {fixture} still runs after 60 s",
     )
     assert case["status"] == "completed", case
     assert case["data"]["mounted"] == list(POSITIONS)
@@ -137,9 +141,12 @@ def test_an_operator_completes_a_started_use_case_on_make_demo_and_ctrl_c_ends_e
     stopping = time.monotonic()
     assert demo.signal(signum) in (0, -signum)  # make dies of the signal once its child ended
     assert "Stopped; every process the demo started has ended." in demo.output()
-    deadline = time.monotonic() + 30
-    while any(alive(pid) for pid in children) and time.monotonic() < deadline:
-        time.sleep(0.2)
+    until(
+        lambda: not any(alive(pid) for pid in children),
+        timeout=30,
+        interval=0.2,
+        message=lambda: f"still running: {[c for p, c in children.items() if alive(p)]}",
+    )
     assert not {pid: command for pid, command in children.items() if alive(pid)}
     print(
         f"\n{name}: demo served in {demo.started_in:.1f} s; the operator's case took "
@@ -173,12 +180,5 @@ def _complete(page: Page, card: Any, form: dict[str, str]) -> None:
     expect(card).to_have_count(0, timeout=LIVE_MS)
 
 
-def _until(
-    read: Callable[[], dict[str, Any]], done: Callable[[dict[str, Any]], bool], timeout: float = 60
-) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout
-    value = read()
-    while not done(value) and time.monotonic() < deadline:
-        time.sleep(0.5)
-        value = read()
-    return value
+def _ended(case: dict[str, Any]) -> dict[str, Any] | None:
+    return case if case["status"] != "running" else None

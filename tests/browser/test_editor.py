@@ -37,7 +37,7 @@ from tests.browser.drawing import (
     pattern_badge,
     select_element,
 )
-from tests.polling import until
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

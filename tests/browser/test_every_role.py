@@ -46,7 +46,7 @@ from tests.browser.drawing import (
     select_element,
 )
 from tests.demo.rig import DemoRun, scratch_postgres
-from tests.polling import until
+from tests.support.polling import until
 from tests.support.workers import RedisProcess
 
 Screenshot = Callable[[Page, str], Path]

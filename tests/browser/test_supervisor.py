@@ -24,7 +24,7 @@ from hrc.cases.simulation import Simulation
 from hrc.organisations.choices import Role
 from tests import factories
 from tests.cases.patterns import cobot_chain, shared_space
-from tests.polling import until
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

@@ -29,7 +29,7 @@ from tests import factories
 from tests.browser.conftest import assert_fits
 from tests.cases.patterns import PICK, PROGRAM, shared_space
 from tests.live.server import LiveServer, MonitorProcess
-from tests.polling import until
+from tests.support.polling import until
 from tests.support.workers import RedisProcess, WorkerProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)

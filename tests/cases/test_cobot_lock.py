@@ -11,7 +11,6 @@ one on the same cobot (two use-case cases sharing cobots did exactly that).
 from __future__ import annotations
 
 import threading
-import time
 from typing import Any
 
 import pytest
@@ -30,6 +29,7 @@ from hrc.cobots.models import Cobot, CobotCommand
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PROGRAM
+from tests.support.polling import until
 from tests.support.workers import RedisProcess
 
 
@@ -119,10 +119,8 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     assert leased.wait(30)
     reacher = threading.Thread(target=second)
     reacher.start()
-    deadline = time.monotonic() + 30
-    while not _waiting_for_a_lock():  # the second lease has begun and waits for the cobot
-        assert time.monotonic() < deadline, "the second lease never waited for the cobot"
-        time.sleep(0.01)
+    # The second lease has begun and waits for the cobot.
+    until(_waiting_for_a_lock, 30, 0.01, "the second lease never waited for the cobot")
     release.set()
     holder.join(30)
     reacher.join(30)

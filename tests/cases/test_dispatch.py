@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 import pytest
@@ -14,6 +13,7 @@ from hrc.cases.models import Job
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import cobot_chain
+from tests.support.polling import until
 from tests.support.workers import RedisProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -45,11 +45,11 @@ def test_the_embedded_sweeper_finds_a_job_whose_doorbell_was_lost(
     settings.HRC_INLINE_TASKS, settings.HRC_SWEEP_SECONDS = True, 0.1
     dispatch.start_embedded_sweeper()
 
-    deadline = time.monotonic() + 15
-    while time.monotonic() < deadline:
-        job.refresh_from_db()
-        if job.last_error:
-            break
-        time.sleep(0.05)
+    until(lambda: _last_error(job), timeout=15, interval=0.05)
     assert cobot.name in job.last_error
     assert job.state in (JobState.QUEUED, JobState.FAILED)  # retried with back-off, or an incident
+
+
+def _last_error(job: Job) -> str:
+    job.refresh_from_db()
+    return job.last_error

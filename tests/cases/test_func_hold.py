@@ -28,7 +28,7 @@ from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PICK, func_hold
-from tests.polling import until
+from tests.support.polling import until
 from tests.support.workers import RedisProcess
 
 pytestmark = pytest.mark.django_db(transaction=True)

@@ -16,7 +16,7 @@ from hrc.cases.models import Case, Incident, Interruption, Job, WorkItem
 from hrc.cases.simulation import Simulation
 from hrc_gateway import urua
 from tests.cases.patterns import scan_until_found, shared_space, unusable_outputs
-from tests.polling import until
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

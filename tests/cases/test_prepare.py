@@ -23,7 +23,7 @@ from hrc.organisations.models import Organisation
 from hrc_gateway import urua
 from tests import factories
 from tests.cases.patterns import PROGRAM, cobot_chain
-from tests.polling import until
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 

@@ -19,6 +19,7 @@ from hrc.cases.choices import CaseStatus, JobState
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
 from tests.cases.patterns import cobot_chain
+from tests.support.polling import until
 from tests.support.workers import RedisProcess, WorkerProcess
 
 TRIALS = 3
@@ -29,14 +30,14 @@ TIME_SCALE = 0.25
 
 def _running_step(timeout: float = 30.0) -> Job:
     """A step that has been on the cobot for a moment: sent, and not yet acknowledged."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        job = Job.objects.filter(state=JobState.RUNNING).first()
-        if job is not None and job.held_by:
-            time.sleep(0.15)  # into the step (it takes ~0.5 s)
-            return job
-        time.sleep(0.01)
-    raise AssertionError("no step started running")
+    job: Job = until(_held_running_job, timeout, 0.01, "no step started running")
+    time.sleep(0.15)  # into the step (it takes ~0.5 s)
+    return job
+
+
+def _held_running_job() -> Job | None:
+    job = Job.objects.filter(state=JobState.RUNNING).first()
+    return job if job is not None and job.held_by else None
 
 
 def _kill_holder(

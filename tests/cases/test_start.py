@@ -15,9 +15,9 @@ from rest_framework.test import APIClient
 
 from hrc.cases import services
 from hrc.cases.choices import CaseStatus
-from hrc.cases.errors import Invalid
 from hrc.cases.models import Case
 from hrc.cobots.models import Cobot
+from hrc.errors import Invalid
 from hrc.organisations import services as organisation_services
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -30,14 +28,6 @@ async def executions(client: Client) -> int:
 
 async def executed_steps(client: Client) -> list[str]:
     return list(await read(client, "Simulator/ExecutedSteps"))
-
-
-async def until(condition: Callable[[], object], timeout: float = 5.0) -> None:
-    """Polls `condition` every 5 ms until it holds; fails the test after `timeout` seconds."""
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "condition not reached in time"
-        await asyncio.sleep(0.005)
 
 
 def save_arm_powered_to_idle(state_file: Path, name: str = "cobot1") -> None:

@@ -18,7 +18,6 @@ import signal
 import socket
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -33,6 +32,7 @@ from hrc.demo.plant import STARTED_CASES
 from hrc_gateway import urua
 from tests.demo.rig import Browserless, DemoRun, alive, scratch_postgres
 from tests.support.paths import ROOT
+from tests.support.polling import until
 from tests.support.workers import RedisProcess
 
 CONFIG = re.compile(r'<script id="tablet-config" type="application/json">(.*?)</script>', re.S)
@@ -152,9 +152,12 @@ def test_a_demo_killed_outright_takes_its_processes_with_it(tmp_path: Path) -> N
         children = demo.descendants()
         assert len(children) >= 3
         assert demo.signal(signal.SIGKILL) == -signal.SIGKILL
-        deadline = time.monotonic() + 30
-        while any(alive(pid) for pid in children) and time.monotonic() < deadline:
-            time.sleep(0.2)
+        until(
+            lambda: not any(alive(pid) for pid in children),
+            timeout=30,
+            interval=0.2,
+            message=lambda: f"still running: {[c for p, c in children.items() if alive(p)]}",
+        )
     finally:
         demo.stop()
     _check_everything_ended(demo, children)

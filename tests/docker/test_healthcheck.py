@@ -6,7 +6,6 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -17,6 +16,7 @@ from hrc.organisations.models import Organisation
 from tests import factories
 from tests.live.server import LiveServer, MonitorProcess
 from tests.support.paths import ROOT
+from tests.support.polling import until
 from tests.support.workers import RedisProcess, WorkerProcess
 
 
@@ -104,10 +104,12 @@ def test_monitor_is_healthy_once_every_active_cobot_has_a_fresh_state(
         assert "no recent state from cobot1" in reason
         monitor = MonitorProcess(tmp_path / "monitor.log").start()
         try:
-            deadline = time.monotonic() + 30
-            while (result := _check("monitor", environment=environment))[0] != 0:
-                assert time.monotonic() < deadline, result
-                time.sleep(0.5)
+            until(
+                lambda: _check("monitor", environment=environment)[0] == 0,
+                timeout=30,
+                interval=0.5,
+                message=lambda: str(_check("monitor", environment=environment)),
+            )
         finally:
             monitor.stop()
     finally:

@@ -7,7 +7,6 @@ client is plain asyncua, doing what the prototype's client service did.
 from __future__ import annotations
 
 import asyncio
-import time
 from collections.abc import AsyncIterator
 from pathlib import Path
 
@@ -17,6 +16,7 @@ from asyncua import Client, ua
 from hrc_gateway import urua
 from hrc_gateway.server import Gateway, GatewayError
 from hrc_gateway.sim.backend import SimBackend
+from tests.support.polling import until_async
 
 
 @pytest.fixture
@@ -214,10 +214,10 @@ def test_insecure_is_refused_off_loopback(tmp_path: Path) -> None:
 
 async def _poll(variable, expected: object, timeout: float = 10) -> None:  # type: ignore[no-untyped-def]
     # The prototype polled every 0.5 s; a shorter period keeps the test quick.
-    deadline = time.monotonic() + timeout
-    while await variable.read_value() != expected:
-        assert time.monotonic() < deadline, f"{variable} never became {expected!r}"
-        await asyncio.sleep(0.02)
+    async def reached() -> bool:
+        return bool(await variable.read_value() == expected)
+
+    await until_async(reached, timeout, 0.02, f"{variable} never became {expected!r}")
 
 
 async def test_an_ipv4_mapped_loopback_host_is_served_as_plain_ipv4(tmp_path: Path) -> None:

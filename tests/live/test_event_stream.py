@@ -4,7 +4,6 @@ exactly the snapshot a tablet that connects afterwards gets."""
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from tests.cases.patterns import cobot_chain
 from tests.live.client import db, open_socket, receive, receive_until, run
 from tests.live.replay import replay
 from tests.live.server import LiveServer, session_cookie
+from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
@@ -37,13 +37,6 @@ def _comparable(snapshot: dict[str, Any]) -> dict[str, Any]:
         {**cobot, "state": None, "queue": {**cobot["queue"], "at": 0}} for cobot in copy["cobots"]
     ]
     return copy
-
-
-def _until(condition: Any, timeout: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "condition not reached in time"
-        time.sleep(0.05)
 
 
 def _operator_item(case_id: int) -> WorkItem:
@@ -65,14 +58,16 @@ def test_deltas_applied_to_an_old_snapshot_give_the_fresh_snapshot(
             case_services.complete_work_item(item, user=operator)
         case_services.start_work_item(_operator_item(third), user=operator)
         simulation.start_cases(1)
-        _until(
+        until(
             lambda: (
                 Case.objects.filter(pk__in=[first, second], status=CaseStatus.COMPLETED).count()
                 == 2
-            )
+            ),
+            timeout=60,
         )
-        _until(
-            lambda: not Job.objects.filter(state__in=[JobState.QUEUED, JobState.RUNNING]).exists()
+        until(
+            lambda: not Job.objects.filter(state__in=[JobState.QUEUED, JobState.RUNNING]).exists(),
+            timeout=60,
         )
         groups.flush()
 

@@ -4,8 +4,8 @@ from django.core.exceptions import ValidationError
 
 from hrc.cases import services as case_services
 from hrc.cases.choices import EventType, WorkItemState
-from hrc.cases.errors import NotFound
 from hrc.cases.models import CaseEvent, WorkItem
+from hrc.errors import NotFound
 from hrc.organisations import services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation

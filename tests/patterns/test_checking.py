@@ -6,7 +6,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 from django.conf import settings
 
@@ -15,6 +14,7 @@ from hrc.patterns import checking
 from hrc.patterns.engine_workers import worker_pids
 from tests import factories
 from tests.demo.rig import alive
+from tests.support.polling import until
 
 
 def test_a_check_runs_in_an_engine_worker_and_answers_as_the_engine_does() -> None:
@@ -62,7 +62,5 @@ def test_a_worker_dies_with_a_server_killed_outright() -> None:
     worker = int(parent.stdout.readline())
     parent.kill()
     parent.wait()
-    deadline = time.monotonic() + 10
-    while alive(worker) and time.monotonic() < deadline:
-        time.sleep(0.05)
+    until(lambda: not alive(worker), timeout=10, interval=0.05)
     assert not alive(worker)

@@ -1,1 +1,1 @@
-"""What the tests and the benchmark share: processes they start (workers, Redis) and paths."""
+"""What the tests and the benchmark share: waiting (polling), the processes they start (workers, Redis), paths."""

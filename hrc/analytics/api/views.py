@@ -71,10 +71,6 @@ def analysed_case(user: AnyUser, pk: int) -> Case:
     return case
 
 
-def _rejected(problem: params.BadParameter) -> Rejected:
-    return Rejected({"detail": str(problem), "parameter": problem.name})
-
-
 class VersionAnalyticsView(APIView):
     @extend_schema(
         parameters=[SINCE, UNTIL],
@@ -89,12 +85,9 @@ class VersionAnalyticsView(APIView):
         one's end, or now while one runs.
         """
         version = analysed_version(request.user, pk)
-        try:
-            since, until = params.window(
-                request.query_params.get("since"), request.query_params.get("until")
-            )
-        except params.BadParameter as problem:
-            raise _rejected(problem) from None
+        since, until = params.window(
+            request.query_params.get("since"), request.query_params.get("until")
+        )
         figures = selectors.version_analytics(version, now=timezone.now(), since=since, until=until)
         report = VersionReport(version, since, until, figures)
         return Response(VersionAnalyticsSerializer(report).data)
@@ -161,13 +154,10 @@ class XesExportView(APIView):
         `case` or both.
         """
         query = request.query_params
-        try:
-            version_id = params.identifier("version", query.get("version"))
-            case_id = params.identifier("case", query.get("case"))
-            lifecycle = params.lifecycle(query.get("lifecycle"))
-            since, until = params.window(query.get("since"), query.get("until"))
-        except params.BadParameter as problem:
-            raise _rejected(problem) from None
+        version_id = params.identifier("version", query.get("version"))
+        case_id = params.identifier("case", query.get("case"))
+        lifecycle = params.lifecycle(query.get("lifecycle"))
+        since, until = params.window(query.get("since"), query.get("until"))
         if version_id is None and case_id is None:
             raise Rejected(
                 {"detail": "Say which cases: version or case (an id).", "parameter": "version"}

@@ -40,6 +40,11 @@ class RefusalSerializer(serializers.Serializer[dict[str, Any]]):
     """Why a request was refused: 400 wrong input, 403 not yours, 404 not found, 409 moved on."""
 
     detail = serializers.CharField()
+    code = serializers.CharField(
+        required=False,
+        help_text="The refusal's name for programs (invalid, not-allowed, conflict, ...); "
+        "absent where the framework itself refused.",
+    )
 
 
 class EnumField(serializers.ChoiceField):

@@ -5,7 +5,7 @@ organisations: an outsider gets 404 and empty lists, also on POST actions.
 Roles are checked per object after that: engineers and admins start, cancel,
 suspend and resume cases, resolve incidents, send messages, set actor
 mappings and reassign work items; operators get 403. Work items are the services' to allow
-(services._locked_item, by selectors.performable_by). The services' refusals (hrc.cases.errors) reach the
+(services._locked_item, by selectors.performable_by). The services' refusals (hrc.errors) reach the
 client as 400, 403 or 409 with a `detail` (hrc.api.exceptions).
 """
 
@@ -48,9 +48,9 @@ from hrc.cases.api.serializers import (
     WorkItemSerializer,
 )
 from hrc.cases.choices import CaseStatus, WorkItemKind
-from hrc.cases.errors import NotFound
 from hrc.cases.messages import receive_message
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
+from hrc.errors import NotFound
 from hrc.organisations.choices import Role
 from hrc.organisations.selectors import may_write_in, role_in
 from hrc.patterns.models import PatternVersion

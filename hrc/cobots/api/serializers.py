@@ -87,6 +87,11 @@ class CommandRefusalSerializer(serializers.Serializer[dict[str, Any]]):
     """Why a command was not carried out; `command` is its record when it was recorded."""
 
     detail = serializers.CharField()
+    code = serializers.CharField(
+        required=False,
+        help_text="The refusal's name for programs (invalid, not-allowed, conflict, ...); "
+        "absent where the framework itself refused.",
+    )
     command = CobotCommandSerializer(required=False)
 
 

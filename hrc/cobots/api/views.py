@@ -41,7 +41,6 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.request import Request
 from rest_framework.response import Response
 
-from hrc.api.exceptions import Rejected
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
 from hrc.cobots import control, services
 from hrc.cobots.api.serializers import (
@@ -170,10 +169,11 @@ class CobotViewSet(viewsets.ModelViewSet[Cobot]):
                 program=body.validated_data.get("program", ""),
             )
         except control.ControlError as error:
-            payload: dict[str, Any] = {"detail": str(error)}
+            # Not an answer made here (the API's handler makes it): only the record, which
+            # only this layer can serialise, joins the refusal's body.
             if error.record is not None:
-                payload["command"] = CobotCommandSerializer(error.record).data
-            raise Rejected(payload, error.status) from None
+                error.extra["command"] = CobotCommandSerializer(error.record).data
+            raise
         return Response(CobotCommandSerializer(record).data)
 
     # Reads -----------------------------------------------------------------------------
@@ -201,11 +201,8 @@ class CobotViewSet(viewsets.ModelViewSet[Cobot]):
     @action(detail=True, methods=["get"])
     def registers(self, request: Request, pk: str | None = None) -> Response:
         cobot = self.get_object()
-        try:
-            names = control.register_names(request.query_params.get("names"))
-            registers = control.read_registers(cobot, names)
-        except control.ControlError as error:
-            raise Rejected({"detail": str(error)}, error.status) from None
+        names = control.register_names(request.query_params.get("names"))
+        registers = control.read_registers(cobot, names)
         return Response({"inputs": registers.inputs, "outputs": registers.outputs})
 
     @extend_schema(
@@ -217,11 +214,7 @@ class CobotViewSet(viewsets.ModelViewSet[Cobot]):
     )
     @action(detail=True, methods=["get"])
     def programs(self, request: Request, pk: str | None = None) -> Response:
-        cobot = self.get_object()
-        try:
-            return Response(control.programs(cobot))
-        except control.ControlError as error:
-            raise Rejected({"detail": str(error)}, error.status) from None
+        return Response(control.programs(self.get_object()))
 
     @extend_schema(
         summary="The cobot's control commands, newest first",

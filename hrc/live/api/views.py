@@ -55,15 +55,12 @@ class ResumeCellView(APIView):
         body.is_valid(raise_exception=True)
         organisation = _organisation(request, body.validated_data.get("organisation"))
         cell = _cell(organisation, body.validated_data["cell"])
-        try:
-            stop = stops.resume_cell(
-                organisation,
-                cell,
-                by=request.user,  # type: ignore[arg-type]
-                confirmed=body.validated_data["confirm"],
-            )
-        except stops.StopError as error:
-            raise Rejected({"detail": str(error)}, error.status) from None
+        stop = stops.resume_cell(
+            organisation,
+            cell,
+            by=request.user,  # type: ignore[arg-type]
+            confirmed=body.validated_data["confirm"],
+        )
         return Response(payloads.stop_data(stop))
 
 

@@ -184,6 +184,11 @@ class CheckReportSerializer(_WithIssueLists):
 
 class PublishRefusedSerializer(serializers.Serializer[dict[str, Any]]):
     detail = serializers.CharField()
+    code = serializers.CharField(
+        required=False,
+        help_text="The refusal's name for programs (invalid, not-allowed, conflict, ...); "
+        "absent where the framework itself refused.",
+    )
     report = CheckReportSerializer()
 
 

@@ -12,8 +12,6 @@ organisations: an outsider gets 404, a user without membership an empty list.
 
 import json
 import re
-from collections.abc import Iterator
-from contextlib import contextmanager
 from typing import Any
 
 from django.db.models import QuerySet
@@ -28,7 +26,7 @@ from drf_spectacular.utils import (
 )
 from rest_framework import serializers, status, viewsets
 from rest_framework.decorators import action
-from rest_framework.exceptions import PermissionDenied, Throttled
+from rest_framework.exceptions import PermissionDenied
 from rest_framework.request import Request
 from rest_framework.response import Response
 from rest_framework.views import APIView
@@ -57,11 +55,10 @@ from hrc.patterns.api.serializers import (
     StartRightsSerializer,
     SwitchSerializer,
 )
-from hrc.patterns.checking import EngineBusy, checked, engine_slot, interactive_budget
+from hrc.patterns.checking import checked, engine_slot, interactive_budget
 from hrc.patterns.choices import DocumentFormat
 from hrc.patterns.documents import (
     FormatError,
-    NoExecutionNet,
     execution_net,
     from_bpmn,
     from_pnml,
@@ -170,10 +167,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         )
 
     def perform_destroy(self, instance: PatternModel) -> None:
-        try:
-            services.delete_pattern(instance)
-        except services.PatternHasVersions as exc:
-            raise Rejected({"detail": str(exc)}, status.HTTP_409_CONFLICT) from None
+        services.delete_pattern(instance)
 
     @extend_schema(request=None, responses={200: CheckReportSerializer})
     @action(detail=True, methods=["post"])
@@ -184,7 +178,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         model is too large to decide (a `state-space-too-large` warning).
         """
         pattern = self.get_object()
-        with _engine_slot(pattern.organisation_id):
+        with engine_slot(pattern.organisation_id):
             return Response(checked(pattern.draft, interactive_budget()))
 
     @extend_schema(
@@ -194,16 +188,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     def publish(self, request: Request, pk: str | None = None) -> Response:
         """Publishes the draft as the next version; refused with the report unless valid and sound."""
         pattern = self.get_object()
-        try:
-            with _engine_slot(pattern.organisation_id):
-                version = services.publish_pattern(pattern, published_by=_user(request))
-        except services.PublishRefused as exc:
-            raise Rejected(
-                {
-                    "detail": "The draft does not pass the check; see the report.",
-                    "report": exc.report,
-                }
-            ) from None
+        with engine_slot(pattern.organisation_id):
+            version = services.publish_pattern(pattern, published_by=_user(request))
         return Response(PatternVersionSerializer(version).data, status=status.HTTP_201_CREATED)
 
     @extend_schema(request=SwitchSerializer, responses=PatternSerializer)
@@ -257,7 +243,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         if xml_body:
             default = DocumentFormat.BPMN if looks_like_bpmn(body) else DocumentFormat.PNML
         document_format = _format_param(request, default)
-        with _engine_slot(organisation.pk):
+        with engine_slot(organisation.pk):
             if document_format == DocumentFormat.PNML:
                 document: object = from_pnml(body)
             elif document_format == DocumentFormat.BPMN:
@@ -290,7 +276,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         """
         document = request.data
         read_draft(document)  # a shape error is the request's fault: 400
-        with _engine_slot(_editing_organisation(request)):
+        with engine_slot(_editing_organisation(request)):
             return Response(checked(document, interactive_budget()))
 
     @extend_schema(
@@ -310,7 +296,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
     @action(detail=False, methods=["post"])
     def layout(self, request: Request) -> Response:
         """Lays the document out: left to right by precedence, each actor's tasks in its lane."""
-        with _engine_slot(_editing_organisation(request)):
+        with engine_slot(_editing_organisation(request)):
             return Response(laid_out(request.data))
 
     @extend_schema(
@@ -334,16 +320,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         pattern it belongs to (see hrc/engine/tokengame.py). A document that breaks
         a structural rule has no execution net: 400 with the rules' issues.
         """
-        try:
-            with _engine_slot(_editing_organisation(request)):
-                net = execution_net(request.data)
-        except NoExecutionNet as exc:
-            raise Rejected(
-                {
-                    "detail": f"The model breaks structural rules, so it cannot be played: {exc}",
-                    "errors": [issue.as_dict() for issue in exc.issues],
-                }
-            ) from None
+        with engine_slot(_editing_organisation(request)):
+            net = execution_net(request.data)
         return Response(net)
 
 
@@ -454,16 +432,6 @@ def _id_param(request: Request, name: str) -> int | None:
     if not ID_PATTERN.fullmatch(value):
         raise Rejected({"detail": f"{name} must be an id (a whole number)."})
     return int(value)
-
-
-@contextmanager
-def _engine_slot(organisation_id: int) -> Iterator[None]:
-    """One of the organisation's engine slots for the block; a 429 with Retry-After when none is free."""
-    try:
-        with engine_slot(organisation_id):
-            yield
-    except EngineBusy as exc:
-        raise Throttled(wait=exc.retry_after, detail=str(exc)) from None
 
 
 def _editing_organisation(request: Request) -> int:

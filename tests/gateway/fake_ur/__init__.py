@@ -20,19 +20,20 @@ import asyncio
 import contextlib
 import fcntl
 import threading
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TypeVar
+from typing import IO, TypeVar
 
 from tests.gateway.fake_ur.controller import FakeController
 from tests.gateway.fake_ur.dashboard_server import FakeDashboardServer
 from tests.gateway.fake_ur.rtde_server import FakeRTDEServer
+from tests.support.polling import until, until_async
 
 HOST = "127.0.0.1"
 RTDE_PORT = 30004
 LOCK_FILE = Path("/tmp/hrc-fake-ur.lock")
 TICK = 0.002  # the controller's 500 Hz cycle
+NEVER_REACHED = "The fake UR never reached the expected state."
 
 T = TypeVar("T")
 
@@ -86,21 +87,13 @@ class FakeUR:
 
     def wait_until(self, condition: Callable[[FakeController], bool], timeout: float = 5.0) -> None:
         """Blocks until `condition(controller)` holds; for synchronous tests."""
-        deadline = time.monotonic() + timeout
-        while not self._holds(condition):
-            if time.monotonic() > deadline:
-                raise TimeoutError("The fake UR never reached the expected state.")
-            time.sleep(0.005)
+        until(lambda: self._holds(condition), timeout, 0.005, NEVER_REACHED)
 
     async def until(
         self, condition: Callable[[FakeController], bool], timeout: float = 5.0
     ) -> None:
         """Waits until `condition(controller)` holds, letting the test's event loop run."""
-        deadline = time.monotonic() + timeout
-        while not self._holds(condition):
-            if time.monotonic() > deadline:
-                raise TimeoutError("The fake UR never reached the expected state.")
-            await asyncio.sleep(0.005)
+        await until_async(lambda: self._holds(condition), timeout, 0.005, NEVER_REACHED)
 
     def _holds(self, condition: Callable[[FakeController], bool]) -> bool:
         with self.controller.lock:
@@ -141,19 +134,21 @@ class FakeUR:
 def machine_lock(timeout: float = 120.0) -> Iterator[None]:
     """Holds /tmp/hrc-fake-ur.lock: one fake UR (port 30004) per machine at a time."""
     with LOCK_FILE.open("a") as handle:
-        deadline = time.monotonic() + timeout
-        while True:
-            try:
-                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except BlockingIOError:
-                if time.monotonic() > deadline:
-                    raise TimeoutError(f"{LOCK_FILE} stayed locked for {timeout:g} s.") from None
-                time.sleep(0.05)
+        until(
+            lambda: _locked(handle), timeout, 0.05, f"{LOCK_FILE} stayed locked for {timeout:g} s."
+        )
         try:
             yield
         finally:
             fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _locked(handle: IO[str]) -> bool:
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True
 
 
 @contextlib.contextmanager

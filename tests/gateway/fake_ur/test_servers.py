@@ -13,6 +13,7 @@ import time
 
 from tests.gateway.fake_ur import HOST, RTDE_PORT, FakeUR, wire
 from tests.gateway.fake_ur.dashboard_server import GREETING
+from tests.support.polling import until
 
 
 class RawRTDE:
@@ -83,10 +84,12 @@ def test_an_input_owned_by_one_connection_is_in_use_for_others_until_it_closes(
         ["IN_USE", "INT32"],
     )
     owner.close()
-    deadline = time.monotonic() + 2
-    while other.setup_inputs("input_int_register_42")[0] == 0:
-        assert time.monotonic() < deadline, "the closed connection kept the register"
-        time.sleep(0.01)
+    until(
+        lambda: other.setup_inputs("input_int_register_42")[0] != 0,
+        timeout=2,
+        interval=0.01,
+        message="the closed connection kept the register",
+    )
     other.close()
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import asyncio
-import time
 from collections.abc import AsyncIterator, Callable, Iterator, Mapping, Sequence
 
 import pytest
@@ -11,6 +10,7 @@ import pytest
 from hrc_gateway.backend import MethodHandler, Value
 from hrc_gateway.ur.backend import URBackend
 from tests.gateway.fake_ur import HOST, FakeUR, running_fake_ur
+from tests.support.polling import until_async
 
 # Short enough for a step that never finishes to fail the test quickly, long enough for CI.
 COMMAND_TIMEOUT = 3.0
@@ -34,11 +34,11 @@ class Published:
     async def until(
         self, path: str, condition: Callable[[Value], bool], timeout: float = 5.0
     ) -> Value:
-        deadline = time.monotonic() + timeout
-        while path not in self.values or not condition(self.values[path]):
-            if time.monotonic() > deadline:
-                raise AssertionError(f"{path} is {self.values.get(path)!r} after {timeout:g} s")
-            await asyncio.sleep(0.005)
+        await until_async(
+            lambda: path in self.values and condition(self.values[path]),
+            timeout,
+            message=lambda: f"{path} is {self.values.get(path)!r} after {timeout:g} s",
+        )
         return self.values[path]
 
     async def equals(self, path: str, value: Value, timeout: float = 5.0) -> None:

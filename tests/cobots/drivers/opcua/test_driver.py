@@ -22,7 +22,8 @@ from hrc.cobots.drivers.base import (
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
 from hrc.cobots.simulated import GatewayProcess, free_port
 from hrc_gateway import urua
-from tests.cobots.simulator import executions, read, until
+from tests.cobots.simulator import executions, read
+from tests.support.polling import until_async
 
 # Coexistence_PickAndPlace: 1 home, 2 move to a pose in the part box (ws 0), 3 pick (2 s wait).
 HOME, MOVE, PICK = 1, 2, 3
@@ -121,7 +122,7 @@ async def test_a_protective_stop_refuses_a_step_without_sending_it(
     driver: OpcUaDriver, observer: Client
 ) -> None:
     await driver.call("Simulator/InjectFault", "protective-stop", "")
-    await until(lambda: driver.cache[urua.STATE_SAFETY_MODE] != urua.SAFETY_NORMAL)
+    await until_async(lambda: driver.cache[urua.STATE_SAFETY_MODE] != urua.SAFETY_NORMAL)
     with pytest.raises(CobotStopped, match="protective stop") as stopped:
         await driver.run_step(StepCommand(step=HOME, fence=Fence(12, 1)))
     assert not stopped.value.transient
@@ -133,7 +134,7 @@ async def test_a_protective_stop_during_a_step_leaves_it_in_doubt_never_hanging(
     driver: OpcUaDriver, observer: Client
 ) -> None:
     step = asyncio.create_task(driver.run_step(StepCommand(step=PICK, fence=Fence(13, 1))))
-    await until(lambda: driver.cache[urua.register_path("Inputs", "Bit64")] is True)
+    await until_async(lambda: driver.cache[urua.register_path("Inputs", "Bit64")] is True)
     await driver.call("Simulator/InjectFault", "protective-stop", "")
     with pytest.raises(CobotStopped, match="in doubt"):
         await asyncio.wait_for(step, 10)
@@ -160,7 +161,7 @@ async def test_a_step_that_never_finishes_times_out(driver: OpcUaDriver) -> None
 
 async def test_a_step_is_refused_when_no_program_plays(driver: OpcUaDriver) -> None:
     await driver.call("StopProgram")
-    await until(lambda: driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_STOPPED)
+    await until_async(lambda: driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_STOPPED)
     with pytest.raises(CobotNotReady, match="not Playing"):
         await driver.run_step(StepCommand(step=HOME, fence=Fence(15, 1)))
 
@@ -189,7 +190,7 @@ async def test_a_gateway_for_another_cobot_reads_as_unreachable_and_is_named_in_
 async def test_the_driver_reconnects_after_dropped_connections(driver: OpcUaDriver) -> None:
     await driver.run_step(StepCommand(step=HOME, fence=Fence(17, 1)))
     await driver.call("Simulator/InjectFault", "disconnect", "")
-    await until(lambda: not driver._alive)
+    await until_async(lambda: not driver._alive)
     result = await driver.run_step(StepCommand(step=PICK, fence=Fence(18, 1)))
     assert result.outcome == "ran"
     ran = await driver.read("Simulator/ExecutedSteps")
@@ -214,5 +215,5 @@ async def test_a_cached_state_follows_what_others_do_to_the_cobot(
     pause = ua.NodeId.from_string(urua.node_id("cobot1", "PauseProgram"))
     await cobot.call_method(pause)  # another client, not ours
 
-    await until(lambda: driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_PAUSED)
+    await until_async(lambda: driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_PAUSED)
     assert (await driver.state(fresh=False))["ProgramState"] == urua.PROGRAM_PAUSED

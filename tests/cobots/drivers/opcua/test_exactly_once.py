@@ -11,7 +11,6 @@ import asyncio
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 from asyncua import Client, ua
@@ -20,8 +19,9 @@ from hrc.cobots.drivers.base import Fence, StepCommand
 from hrc.cobots.drivers.opcua.driver import OpcUaDriver
 from hrc.cobots.simulated import GatewayProcess
 from hrc_gateway import urua
-from tests.cobots.simulator import PROGRAM, executed_steps, executions, read, until
+from tests.cobots.simulator import PROGRAM, executed_steps, executions, read
 from tests.support.paths import ROOT
+from tests.support.polling import until_async
 
 PICK = 3  # Coexistence_PickAndPlace: a 2 s (simulated) pick
 IN_BIT = urua.register_path("Inputs", "Bit64")
@@ -87,7 +87,7 @@ async def test_a_gateway_restarted_mid_step_finishes_the_step_once(tmp_path: Pat
         await driver.call("SelectProgram", PROGRAM)
         await driver.call("StartProgram")
         step = asyncio.create_task(driver.run_step(StepCommand(step=PICK, fence=Fence(600, 1))))
-        await until(lambda: driver.cache.get(IN_BIT) is True, timeout=10)
+        await until_async(lambda: driver.cache.get(IN_BIT) is True, timeout=10)
         gateway.kill()
         await asyncio.sleep(0.3)
         await asyncio.to_thread(gateway.start)
@@ -129,7 +129,7 @@ async def _prototype_write(client: Client, registers: dict[str, object]) -> None
 
 
 async def _until_value(client: Client, path: str, value: object, timeout: float = 10) -> None:
-    deadline = time.monotonic() + timeout
-    while await read(client, path) != value:
-        assert time.monotonic() < deadline, f"{path} never became {value!r}"
-        await asyncio.sleep(0.005)
+    async def reached() -> bool:
+        return bool(await read(client, path) == value)
+
+    await until_async(reached, timeout, message=f"{path} never became {value!r}")

@@ -1,1 +1,0 @@
-"""Background jobs of the organisations app: none yet (invitations and syncs would live here)."""
