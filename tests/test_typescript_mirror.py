@@ -91,7 +91,11 @@ def _read(path: str, name: str, kind: Callable[[typing.Any], object]) -> object:
     return kind(read_literal((FRONTEND / path).read_text(), name))
 
 
-@pytest.mark.parametrize(("path", "name", "kind", "python"), MIRRORS, ids=lambda v: str(v)[:40])
+# By file and name: a set's printed order differs between processes, and xdist's workers must agree.
+MIRROR_IDS = [f"{path}:{name}" for path, name, _kind, _python in MIRRORS]
+
+
+@pytest.mark.parametrize(("path", "name", "kind", "python"), MIRRORS, ids=MIRROR_IDS)
 def test_the_typescript_copy_says_what_python_says(
     path: str, name: str, kind: Callable[[typing.Any], object], python: object
 ) -> None:
@@ -107,7 +111,7 @@ def _sample(python: object) -> str:
     return str(python)
 
 
-@pytest.mark.parametrize(("path", "name", "kind", "python"), MIRRORS, ids=lambda v: str(v)[:40])
+@pytest.mark.parametrize(("path", "name", "kind", "python"), MIRRORS, ids=MIRROR_IDS)
 def test_a_changed_value_in_the_copy_is_seen(
     path: str, name: str, kind: Callable[[typing.Any], object], python: object
 ) -> None:
