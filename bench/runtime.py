@@ -291,7 +291,6 @@ def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 
         return False
 
     until(completed, timeout, poll, f"Cases still open after {timeout:.0f} s.")
-    raise TimeoutError(f"Cases still open after {timeout:.0f} s.")
 
 
 # (b) throughput -------------------------------------------------------------------------------

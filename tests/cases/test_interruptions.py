@@ -14,6 +14,7 @@ from django.utils import timezone
 
 from hrc.cases import dispatch, interruptions
 from hrc.cases.choices import InterruptionMode
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption
 from hrc.cobots.commands import in_transaction
 from hrc.cobots.drivers.base import CobotUnreachable
@@ -97,7 +98,7 @@ def test_a_failed_pause_is_recorded_for_the_sweeper_which_sends_it_again(
     interruption.refresh_from_db()
     assert (interruption.paused_at, interruption.claimed_at) == (None, None)
     assert interruption.error == "pause: cobot1 does not answer"
-    assert interruptions.to_redo() == [("interrupt_cobot", interruption.pk)]
+    assert interruptions.to_redo() == [(Task.INTERRUPT_COBOT, interruption.pk)]
     driver.failure = None
     interruptions.interrupt_cobot(interruption.pk)
     assert driver.sent == [("PauseProgram", False), ("PauseProgram", False)]
@@ -117,7 +118,7 @@ def test_the_resume_goes_out_once_and_rings_the_queue(
     assert driver.sent == [("PauseProgram", False), ("StartProgram", False)]
     interruption.refresh_from_db()
     assert interruption.settled
-    assert [name for name, _ in rung] == ["run_job"]  # the cobot's queued step
+    assert [name for name, _ in rung] == [Task.RUN_JOB]  # the cobot's queued step
 
 
 def test_an_interruption_that_ends_while_its_pause_is_on_its_way_gets_its_resume(
@@ -132,7 +133,7 @@ def test_an_interruption_that_ends_while_its_pause_is_on_its_way_gets_its_resume
     interruptions.interrupt_cobot(interruption.pk)
 
     assert driver.sent == [("PauseProgram", False)]
-    assert rung == [("resume_cobot", interruption.pk)]
+    assert rung == [(Task.RESUME_COBOT, interruption.pk)]
     driver.meanwhile = lambda: None
     interruptions.resume_cobot(interruption.pk)
     assert driver.sent == [("PauseProgram", False), ("StartProgram", False)]
