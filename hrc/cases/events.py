@@ -76,7 +76,7 @@ _PUBLISHER = _Publisher()
 def register_publisher(
     *, case_event: CaseEventHook, cobot_queue: CobotQueueHook, hold: HoldHook
 ) -> None:
-    """Called once by the app that serves the tablets, from its AppConfig.ready()."""
+    """Called once by the app that serves the tablets, from its receivers.py."""
     _PUBLISHER.case_event = case_event
     _PUBLISHER.cobot_queue = cobot_queue
     _PUBLISHER.hold = hold

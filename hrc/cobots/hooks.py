@@ -45,7 +45,7 @@ _REGISTERED = _CobotUse()
 
 
 def register_cobot_use(*, in_use: InUse, queue_lengths: QueueLengths) -> None:
-    """Called once by the app that runs cases, from its AppConfig.ready()."""
+    """Called once by the app that runs cases, from its receivers.py."""
     _REGISTERED.in_use = in_use
     _REGISTERED.queue_lengths = queue_lengths
 

@@ -5,8 +5,8 @@ when an admin deactivates a person, the tasks that person holds must go back
 to their team, and only the cases app knows them; before a cell is deleted,
 only the cobots app knows who stands in it; when a membership ends, only the
 live app knows the person's open sockets. Each registers its answer in its
-AppConfig.ready() (hrc.cases.apps, hrc.cobots.apps, hrc.live.apps); nothing registered means
-nothing held and nobody standing there.
+receivers.py (hrc.cases, hrc.cobots, hrc.live), which its AppConfig.ready() loads; nothing
+registered means nothing held and nobody standing there.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ _ENDED: list[MembershipEnded] = []
 
 
 def register_member_leaving(hand_back: HandBack) -> None:
-    """Called once by the app that runs cases, from its AppConfig.ready()."""
+    """Called once by the app that runs cases, from its receivers.py."""
     if hand_back not in _HAND_BACK:
         _HAND_BACK.append(hand_back)
 
@@ -42,7 +42,7 @@ def hand_back_work(user: User, organisation_id: int, by: User | None) -> int:
 
 
 def register_cell_occupants(occupants: Occupants) -> None:
-    """Called once by the app that places things in cells, from its AppConfig.ready()."""
+    """Called once by the app that places things in cells, from its receivers.py."""
     if occupants not in _OCCUPANTS:
         _OCCUPANTS.append(occupants)
 
@@ -53,7 +53,7 @@ def cell_occupants(organisation_id: int, cell: str) -> list[str]:
 
 
 def register_membership_ended(ended: MembershipEnded) -> None:
-    """Called once by the app that holds people's live connections, from its AppConfig.ready()."""
+    """Called once by the app that holds people's live connections, from its receivers.py."""
     if ended not in _ENDED:
         _ENDED.append(ended)
 

@@ -5,7 +5,7 @@ organisations: an outsider gets 404 and empty lists, also on POST actions.
 Roles are checked per object after that: engineers and admins start, cancel,
 suspend and resume cases, resolve incidents, send messages, set actor
 mappings and reassign work items; operators get 403. Work items are the services' to allow
-(services._locked_item, by selectors.performable_by). The services' refusals (hrc.errors) reach the
+(progress.lock_operator_item, by selectors.performable_by). The services' refusals (hrc.errors) reach the
 client as 400, 403 or 409 with a `detail` (hrc.api.exceptions).
 """
 
