@@ -108,7 +108,12 @@ def _coexistence_unmet(pattern: Pattern) -> list[str]:
     shared = sorted({a for a in actor_ids if actor_ids.count(a) > 1})
     if shared:
         reasons.append(f"the processes must be disjoint, but {', '.join(shared)} work in several")
-    workpieces = [p.workpiece for p in processes if p.workpiece is not None]
+    # A process without a workpiece breaks wpassign (rule unassigned-workpiece), so the
+    # processes are compared on what they say they work on and none is left out.
+    unassigned = [p.id for p in processes if not (p.workpiece or "").strip()]
+    if unassigned:
+        reasons.append(f"each process needs its own workpiece, {', '.join(unassigned)} have none")
+    workpieces = [p.workpiece for p in processes if p.id not in unassigned]
     repeated = sorted({w for w in workpieces if workpieces.count(w) > 1})
     if repeated:
         reasons.append(
