@@ -378,7 +378,7 @@ PM4PY_NET = """<?xml version='1.0' encoding='UTF-8'?>
 """
 
 
-def test_a_pm4py_net_imports_as_a_net_without_actors() -> None:
+def test_a_pm4py_net_imports_as_a_net_without_actors_working_on_the_nets_workpiece() -> None:
     pattern = pnml_to_pattern(PM4PY_NET.encode())
     assert pattern == Pattern(
         name="Assembly line",
@@ -386,7 +386,7 @@ def test_a_pm4py_net_imports_as_a_net_without_actors() -> None:
         processes=(
             Process(
                 id="imported_1700000000",
-                workpiece=None,
+                workpiece="Assembly line",  # named after the net
                 actors=(),
                 places=(Place("source", 1), Place("p_3"), Place("sink")),
                 transitions=(Transition("t_pick", None, "pick insert"), Transition("skip_1")),

@@ -1,14 +1,16 @@
 """Every rule of pattern-format.md, each with a model that breaks it and nothing else."""
 
 import copy
+import json
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from hrc.engine import check_document
 from hrc.engine.issues import ERROR_CODES
-from tests.engine.builders import document, process, two_lanes
+from tests.engine.builders import EXAMPLES, document, process, two_lanes
 
 Doc = dict[str, Any]
 
@@ -353,3 +355,22 @@ def test_an_arc_between_two_places_says_what_to_put_between_them() -> None:
 
     assert issue.message.startswith("The arrow from place p2 to place p3 joins two places")
     assert issue.elements == ("p2", "p3")
+
+
+THESIS_INSTANTIATIONS = sorted(EXAMPLES.glob("*.json"))
+USE_CASES = sorted((EXAMPLES / "use_cases").glob("*.json"))
+
+
+def test_the_shipped_library_has_the_eight_instantiations_and_seven_use_cases() -> None:
+    assert len(THESIS_INSTANTIATIONS) == 8
+    assert len(USE_CASES) >= 7
+
+
+@pytest.mark.parametrize(
+    "path", THESIS_INSTANTIATIONS + USE_CASES, ids=lambda path: f"{path.parent.name}/{path.stem}"
+)
+def test_every_shipped_document_keeps_every_rule(path: Path) -> None:
+    report = check_document(json.loads(path.read_text(encoding="utf-8")))
+
+    assert report.errors == (), report.as_dict()
+    assert report.valid is True
