@@ -169,6 +169,23 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
     expect(pattern_badge(page)).to_have_text("Synchronized")
 
+    # A second type on the same ordered pair: constr is a function, so the check names the
+    # pair and the editor marks its two tasks and both constraint lines between them.
+    connect(page, "to1", "tc2", "constraint.space")
+    conflict = page.locator('.hrc-issue[data-code="constraint-conflict"]')
+    expect(conflict).to_contain_text(
+        "“prepare workpiece” → “place insert” give one pair of tasks 2 types", timeout=CHECKED
+    )
+    expect(page.locator(".djs-connection.hrc-has-error .hrc-constraint")).to_have_count(2)
+    for task in ("to1", "tc2"):
+        badge = page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')
+        expect(badge).to_have_attribute("data-codes", re.compile(r"\bconstraint-conflict\b"))
+    screenshot(page, "editor-assembly-constraint-conflict")
+    select_element(page, "p1")
+    page.keyboard.press("Control+z")
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    expect(page.locator(".djs-connection.hrc-has-error")).to_have_count(0)
+
     page.get_by_role("button", name="Publish", exact=True).click()
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text(
         "Published version 1.", timeout=CHECKED
