@@ -119,7 +119,7 @@ def patterns(draw: st.DrawFn, mutate: bool = True) -> dict[str, Any]:
         if [transition, target] not in builder.arcs:
             builder.arc(transition, target)
     tasks = [t for t in builder.transitions if "performer" in t]
-    constraints = []
+    constraints: list[dict[str, str]] = []
     for _ in range(draw(st.integers(0, 3))):
         a, b = draw(st.sampled_from(tasks)), draw(st.sampled_from(tasks))
         # constr is a partial function: one constraint per ordered pair of tasks.
