@@ -217,7 +217,7 @@ def _no_actors(pattern: Pattern, names: Names) -> Iterable[Issue]:
     if not pattern.actors:
         yield error(
             "no-actors",
-            "The pattern has no actors: add an operator or a cobot and draw its lane in "
+            "The pattern has no actors: add an operator or cobot lane to "
             f"{'the drawing' if len(pattern.processes) == 1 else 'each process'}.",
             *(process.id for process in pattern.processes),
         )
@@ -237,8 +237,9 @@ def _workpieces(pattern: Pattern, names: Names) -> Iterable[Issue]:
         if not (process.workpiece or "").strip():
             yield error(
                 "unassigned-workpiece",
-                f"{sentence(names.process(process.id))} works on no workpiece: name the "
-                "workpiece it works on in the process's properties.",
+                f"{sentence(names.process(process.id))} works on no workpiece: every process "
+                "works on one, so name it in the pattern's properties (select nothing, then "
+                f"Workpiece of net {process.id}).",
                 process.id,
             )
 
