@@ -197,7 +197,7 @@ def _constraint_pairs(pattern: Pattern, names: Names) -> Iterable[Issue]:
                 yield error(
                     "constraint-duplicate",
                     f"The {constraint_type} constraint {pair} is drawn {count} times: "
-                    "a constraint is written once, so delete the copies.",
+                    "a constraint is written once, so delete all but one.",
                     a,
                     b,
                 )
