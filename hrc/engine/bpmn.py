@@ -17,7 +17,7 @@ of business process models in BPMN", Information and Software Technology 50
 | exclusive gateway G | a place where the choice or merge happens, with a silent transition per branch: a split keeps its incoming flow's place and gets a transition `G_<flow>` into each outgoing flow's place (the flow's condition becomes that transition's `guard`; the default flow's is "none of the others"); a merge gets a transition per incoming flow into the outgoing flow's place; a gateway with several of each gets its own place G between them |
 | lane | an actor (id: the lane's id), performing the tasks in it (the innermost lane when lanes nest); lanes without tasks are left out |
 | pool without lanes | one actor: the participant, or `<process>_actor` |
-| process | a process of the pattern (several pools: several processes, as in Coexistence) |
+| process | a process of the pattern (several pools: several processes, as in Coexistence); its workpiece is its `hrc:workpiece` attribute, else the name of its pool, else its own name or id (wpassign is total) |
 
 Actor type: the lane's `hrc:actorType` attribute (`cobot` or `operator`),
 else `cobot` when the lane's name (or id) contains "cobot" or "robot" (any
@@ -181,6 +181,16 @@ def _children(element: ET.Element, local: str) -> list[ET.Element]:
 
 def _hrc(element: ET.Element, name: str) -> str | None:
     return element.get(f"{{{HRC_NAMESPACE}}}{name}")
+
+
+def _workpiece(process: ET.Element, pool: ET.Element | None, process_id: str) -> str:
+    """What the process works on: ours as exported, else named after its pool or itself."""
+    candidates = [
+        _hrc(process, "workpiece"),
+        pool.get("name") if pool is not None else None,
+        process.get("name"),
+    ]
+    return next((c.strip() for c in candidates if c and c.strip()), process_id)
 
 
 class _Importer:
@@ -364,10 +374,7 @@ class _Importer:
                 "sink place.",
                 process_xml_id,
             )
-        data: Json = {"id": process_id}
-        workpiece = _hrc(element, "workpiece")
-        if workpiece is not None:
-            data["workpiece"] = workpiece
+        data: Json = {"id": process_id, "workpiece": _workpiece(element, pool, process_id)}
         data["actors"] = list(dict.fromkeys(lanes.values()))
         if element.get("name"):
             data["name"] = element.get("name")

@@ -108,7 +108,13 @@ def _coexistence_unmet(pattern: Pattern) -> list[str]:
     shared = sorted({a for a in actor_ids if actor_ids.count(a) > 1})
     if shared:
         reasons.append(f"the processes must be disjoint, but {', '.join(shared)} work in several")
-    workpieces = [p.workpiece for p in processes if p.workpiece is not None]
+    # wpassign is total (rule unassigned-workpiece): a process without a workpiece is not
+    # counted as disjoint from the others, it breaks Coexistence as it breaks the rule.
+    unassigned = [p.id for p in processes if p.workpiece is None or not p.workpiece.strip()]
+    if unassigned:
+        have = "has" if len(unassigned) == 1 else "have"
+        reasons.append(f"each process needs its own workpiece, {', '.join(unassigned)} {have} none")
+    workpieces = [p.workpiece for p in processes if p.workpiece and p.id not in unassigned]
     repeated = sorted({w for w in workpieces if workpieces.count(w) > 1})
     if repeated:
         reasons.append(

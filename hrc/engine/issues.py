@@ -19,6 +19,10 @@ STRUCTURAL_CODES = (
     "constraint-unperformed",
     "constraint-same-performer",
     "constraint-type",
+    "constraint-duplicate",
+    "constraint-conflict",
+    "no-actors",
+    "unassigned-workpiece",
     "not-workflow-net",
 )
 # task-config: a task, guard or message configuration the runtime could not run (taskconfig.py).

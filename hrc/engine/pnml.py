@@ -11,7 +11,9 @@ object that the standard part does not carry faithfully, and overrides the
 standard part on import, so our own files come back exactly.
 
 `pnml_to_pattern` reads those files, and PNML from other tools (pm4py, WoPeD,
-PIPE, ...) as one process per `<net>`, without actors. Both ways build an
+PIPE, ...) as one process per `<net>`, without actors (a draft the engineer
+gives lanes: `no-actors`), working on a workpiece named after the net's name
+or id (wpassign is total). Both ways build an
 `hrc-pattern/1` document and hand it to `read_pattern`, so a PNML file passes
 the same shape checks as a JSON one and fails with the same `FormatError`.
 Arcs are kept as written: an arc to a node that does not exist is the rules'
@@ -435,8 +437,11 @@ class _Reader:
     def _foreign_process(self, net: ET.Element) -> Json:
         contents = self._contents(net, own=False)
         names = self._names([contents])
+        net_id = net.get("id", "")
+        label = self._label(net)
         return {
-            "id": net.get("id", ""),
+            "id": net_id,
+            "workpiece": label.strip() if label and label.strip() else net_id,
             "places": [
                 self._place(node, own=False) for node in contents.nodes if node.kind == "place"
             ],

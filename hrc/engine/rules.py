@@ -24,6 +24,9 @@ def check_rules(pattern: Pattern) -> list[Issue]:
         *_arcs(pattern, names),
         *_actors(pattern, names),
         *_constraints(pattern, names),
+        *_constraint_pairs(pattern, names),
+        *_no_actors(pattern, names),
+        *_workpieces(pattern, names),
         *(issue for process in pattern.processes for issue in _workflow_net(process, names)),
     ]
 
@@ -178,6 +181,66 @@ def _constraints(pattern: Pattern, names: Names) -> Iterable[Issue]:
                 "arrows).",
                 a,
                 b,
+            )
+
+
+def _constraint_pairs(pattern: Pattern, names: Names) -> Iterable[Issue]:
+    """constr is a partial function T × T ⇀ {time, space, func}: one type per ordered pair."""
+    written: dict[tuple[str, str], list[str]] = defaultdict(list)
+    for constraint in pattern.constraints:
+        if constraint.source != constraint.target and constraint.type in CONSTRAINT_TYPES:
+            written[constraint.source, constraint.target].append(constraint.type)
+    for (a, b), types in written.items():
+        pair = f"{names.name(a)} → {names.name(b)}"
+        for constraint_type, count in Counter(types).items():
+            if count > 1:
+                yield error(
+                    "constraint-duplicate",
+                    f"The {constraint_type} constraint {pair} is drawn {count} times: "
+                    "a constraint is written once, so delete all but one.",
+                    a,
+                    b,
+                )
+        distinct = list(dict.fromkeys(types))
+        if len(distinct) > 1:
+            yield error(
+                "constraint-conflict",
+                f"The constraints {pair} give one pair of tasks {len(distinct)} types "
+                f"({', '.join(distinct)}): an ordered pair of tasks has one constraint type, "
+                "so keep the one you mean and delete the others.",
+                a,
+                b,
+            )
+
+
+def _no_actors(pattern: Pattern, names: Names) -> Iterable[Issue]:
+    if not pattern.actors:
+        yield error(
+            "no-actors",
+            "The pattern has no actors: add an operator or cobot lane to "
+            f"{'the drawing' if len(pattern.processes) == 1 else 'each process'}.",
+            *(process.id for process in pattern.processes),
+        )
+        return
+    for process in pattern.processes:
+        if not process.actors:
+            yield error(
+                "no-actors",
+                f"{sentence(names.process(process.id))} has no actors: draw a lane for the "
+                "operator or cobot who performs its tasks.",
+                process.id,
+            )
+
+
+def _workpieces(pattern: Pattern, names: Names) -> Iterable[Issue]:
+    for process in pattern.processes:
+        if not (process.workpiece or "").strip():
+            yield error(
+                "unassigned-workpiece",
+                f"{sentence(names.process(process.id))} works on no workpiece: every process "
+                "works on one, so name it in the pattern's properties (select nothing, then "
+                f"Workpiece of net {process.id}).",
+                process.id,
             )
 
 

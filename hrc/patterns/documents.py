@@ -41,6 +41,8 @@ from hrc.errors import Invalid
 # Deeper than any real pattern document (about 6 levels, plus the editor's layout),
 # shallow enough that nothing downstream (json, jsonb, the serializers) recurses too far.
 MAX_DEPTH = 64
+# What a new process works on until the engineer names it (the editor gives its new processes the same).
+DEFAULT_WORKPIECE = "workpiece"
 
 Report = dict[str, Any]
 
@@ -66,7 +68,14 @@ def starter_document(name: str) -> dict[str, Any]:
         "name": name,
         "actors": [],
         "processes": [
-            {"id": "N", "actors": [], "places": [{"id": "p1"}], "transitions": [], "arcs": []}
+            {
+                "id": "N",
+                "workpiece": DEFAULT_WORKPIECE,
+                "actors": [],
+                "places": [{"id": "p1"}],
+                "transitions": [],
+                "arcs": [],
+            }
         ],
         "constraints": [],
     }

@@ -2,6 +2,9 @@
 
 from django.db.models import Max, QuerySet
 
+from hrc.engine import FormatError, read_pattern
+from hrc.engine.issues import Issue
+from hrc.engine.rules import check_rules
 from hrc.organisations.choices import Role
 from hrc.organisations.selectors import AnyUser, organisations_of, role_in
 from hrc.patterns.models import PatternModel, PatternVersion
@@ -64,3 +67,17 @@ def versions_startable_at(user: AnyUser, cell: str) -> list[PatternVersion]:
         for version in candidates
         if cell in version.start_cells and why_may_not_start(user, version, cell=cell) is None
     ]
+
+
+def rules_a_new_version_must_fix(version: PatternVersion) -> list[Issue]:
+    """The rules the version's document breaks today; [] when it keeps every one.
+
+    A version was valid when it was published, so what this finds are rules
+    added since. The version keeps running (its cases are never re-checked);
+    a new version of the pattern must fix them to be published. The rules are
+    linear in the size of the document, cheap enough to run on every page view.
+    """
+    try:
+        return check_rules(read_pattern(version.document))
+    except FormatError as exc:
+        return list(exc.issues)

@@ -169,6 +169,27 @@ def test_an_engineer_draws_assembly_sees_it_checked_breaks_it_undoes_and_publish
     expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
     expect(pattern_badge(page)).to_have_text("Synchronized")
 
+    # wpassign is total: the new net works on "workpiece" until it is named; a net without one
+    # is unassigned-workpiece, which the editor marks on the net's lanes.
+    below = element_box(page, "o")
+    page.mouse.click(below["x"] + 300, below["y"] + below["height"] + 60)  # nothing selected
+    workpiece = page.get_by_role("region", name="Properties").get_by_label("Workpiece of net N")
+    expect(workpiece).to_have_value("workpiece")
+    workpiece.fill("")
+    workpiece.press("Tab")
+    unassigned = page.locator('.hrc-issue[data-code="unassigned-workpiece"]')
+    expect(unassigned).to_contain_text("The drawing works on no workpiece", timeout=CHECKED)
+    for lane in ("c", "o"):
+        expect(page.locator(f'.djs-shape.hrc-has-error[data-element-id="{lane}"]')).to_have_count(1)
+        badge = page.locator(f'.hrc-issue-badge.hrc-error[data-element="{lane}"]')
+        expect(badge).to_have_attribute("data-codes", "unassigned-workpiece")
+    screenshot(page, "editor-assembly-no-workpiece")
+    workpiece = page.get_by_role("region", name="Properties").get_by_label("Workpiece of net N")
+    workpiece.fill("w")
+    workpiece.press("Tab")
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    expect(page.locator(".djs-shape.hrc-has-error")).to_have_count(0)
+
     page.get_by_role("button", name="Publish", exact=True).click()
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text(
         "Published version 1.", timeout=CHECKED
@@ -195,6 +216,7 @@ def _assert_is_the_thesis_assembly(document: dict[str, Any]) -> None:
         "o": None,
     }
     assert sorted(process["actors"]) == ["c", "o"]
+    assert process["workpiece"] == expected["workpiece"]
     assert sorted(p["id"] for p in process["places"]) == sorted(p["id"] for p in expected["places"])
     assert {p["id"]: p.get("tokens") for p in process["places"] if p.get("tokens")} == {"p1": 1}
 
@@ -207,6 +229,34 @@ def _assert_is_the_thesis_assembly(document: dict[str, Any]) -> None:
         (c["from"], c["to"], c["type"]) for c in thesis["constraints"]
     )
     assert all("layout" in node for node in process["places"] + process["transitions"])
+
+
+def test_a_second_constraint_type_on_one_pair_is_marked_on_its_tasks_and_lines(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+) -> None:
+    document = json.loads((EXAMPLES / "synch_1o1c_assembly.json").read_text())
+    document["constraints"].append({"from": "to1", "to": "tc2", "type": "space"})
+    pattern = factories.make_pattern(organisation, draft=document, name="Conflicting")
+    sign_in(page, engineer)
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+
+    conflict = page.locator('.hrc-issue[data-code="constraint-conflict"]')
+    expect(conflict).to_contain_text(
+        "“prepare workpiece” → “place insert” give one pair of tasks 2 types (time, space)",
+        timeout=CHECKED,
+    )
+    expect(page.locator(".djs-connection.hrc-has-error .hrc-constraint")).to_have_count(2)
+    for task in ("to1", "tc2"):
+        badge = page.locator(f'.hrc-issue-badge.hrc-error[data-element="{task}"]')
+        expect(badge).to_have_attribute("data-codes", re.compile(r"\bconstraint-conflict\b"))
+    # The other constraint (tc3 → to2) is not part of it.
+    expect(page.locator(".djs-connection .hrc-constraint")).to_have_count(3)
+    screenshot(page, "editor-constraint-conflict")
 
 
 def _assembly(organisation: Organisation) -> PatternModel:

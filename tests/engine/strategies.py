@@ -119,10 +119,12 @@ def patterns(draw: st.DrawFn, mutate: bool = True) -> dict[str, Any]:
         if [transition, target] not in builder.arcs:
             builder.arc(transition, target)
     tasks = [t for t in builder.transitions if "performer" in t]
-    constraints = []
+    constraints: list[dict[str, str]] = []
     for _ in range(draw(st.integers(0, 3))):
         a, b = draw(st.sampled_from(tasks)), draw(st.sampled_from(tasks))
-        if a["performer"] != b["performer"]:
+        # constr is a partial function: one constraint per ordered pair of tasks.
+        taken = {(c["from"], c["to"]) for c in constraints}
+        if a["performer"] != b["performer"] and (a["id"], b["id"]) not in taken:
             kind = draw(st.sampled_from(["time", "func", "space"]))
             constraints.append({"from": a["id"], "to": b["id"], "type": kind})
     actors = sorted({t["performer"] for t in tasks})

@@ -598,6 +598,7 @@ def test_pools_become_processes_and_a_pool_without_lanes_one_actor() -> None:
     assert report.sound
     # Formally sound; BPMN names no cobot program, so the engineer gives one before it runs.
     assert [(i.code, i.elements) for i in report.errors] == [("task-config", ("a",))]
+    assert [p.workpiece for p in pattern.processes] == ["Robot cell", "Packer"]
 
 
 def test_a_process_without_pool_or_lanes_gets_an_actor_of_its_own() -> None:
@@ -607,6 +608,7 @@ def test_a_process_without_pool_or_lanes_gets_an_actor_of_its_own() -> None:
     pattern = bpmn_to_pattern(text)
     assert [a.id for a in pattern.actors] == ["P_actor"]
     assert pattern.name == "Test process"
+    assert pattern.processes[0].workpiece == "Test process"  # wpassign is total
 
 
 def test_data_objects_documentation_and_vendor_extensions_are_ignored() -> None:

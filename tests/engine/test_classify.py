@@ -73,6 +73,20 @@ def test_coexistence_processes_must_not_share_a_workpiece() -> None:
     assert report.patterns == ()
 
 
+def test_coexistence_does_not_skip_a_process_without_a_workpiece() -> None:
+    first = process("N1", "p11 tc1 p12", performers={"tc1": "c"}, workpiece="w1")
+    second = process("N2", "p21 to1 p22", performers={"to1": "o"})
+    del second["workpiece"]
+
+    report = check_document(document(first, second, declared="coexistence"))
+
+    assert report.patterns == ()
+    codes = [(e.code, e.elements) for e in report.errors]
+    assert ("unassigned-workpiece", ("N2",)) in codes
+    mismatch = next(e for e in report.errors if e.code == "pattern-mismatch")
+    assert "each process needs its own workpiece, N2 has none" in mismatch.message
+
+
 def test_a_declared_pattern_that_does_not_hold_is_an_error_naming_the_failed_requirement() -> None:
     report = check_document(two_lanes([("to1", "tc2", "time")], declared="collaboration"))
 

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from hrc.engine.check import check_pattern
 from hrc.engine.document import FormatError, read_pattern, write_pattern
 from hrc.engine.model import (
     ACTOR_TYPES,
@@ -378,7 +379,7 @@ PM4PY_NET = """<?xml version='1.0' encoding='UTF-8'?>
 """
 
 
-def test_a_pm4py_net_imports_as_a_net_without_actors() -> None:
+def test_a_pm4py_net_imports_as_a_net_without_actors_working_on_the_nets_workpiece() -> None:
     pattern = pnml_to_pattern(PM4PY_NET.encode())
     assert pattern == Pattern(
         name="Assembly line",
@@ -386,7 +387,7 @@ def test_a_pm4py_net_imports_as_a_net_without_actors() -> None:
         processes=(
             Process(
                 id="imported_1700000000",
-                workpiece=None,
+                workpiece="Assembly line",  # named after the net
                 actors=(),
                 places=(Place("source", 1), Place("p_3"), Place("sink")),
                 transitions=(Transition("t_pick", None, "pick insert"), Transition("skip_1")),
@@ -403,6 +404,14 @@ def test_a_pm4py_net_imports_as_a_net_without_actors() -> None:
     process = pattern.processes[0]
     assert process.places[1].extra == {"name": "buffer"}
     assert process.transitions[0].extra == {"x": 120, "y": 40.5}
+
+
+def test_a_foreign_net_checks_as_a_draft_that_needs_lanes_but_has_its_workpiece() -> None:
+    report = check_pattern(pnml_to_pattern(PM4PY_NET.encode()))
+
+    assert [(i.code, i.elements) for i in report.errors] == [
+        ("no-actors", ("imported_1700000000",))
+    ]
 
 
 def test_pages_are_flattened_and_references_resolved() -> None:

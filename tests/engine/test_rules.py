@@ -1,14 +1,16 @@
 """Every rule of pattern-format.md, each with a model that breaks it and nothing else."""
 
 import copy
+import json
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from hrc.engine import check_document
 from hrc.engine.issues import ERROR_CODES
-from tests.engine.builders import document, process, two_lanes
+from tests.engine.builders import EXAMPLES, document, process, two_lanes
 
 Doc = dict[str, Any]
 
@@ -70,6 +72,26 @@ def _constraint_type(data: Doc) -> None:
     data["constraints"].append({"from": "tc1", "to": "to2", "type": "temporal"})
 
 
+def _duplicate_constraint(data: Doc) -> None:
+    data["constraints"].append({"from": "to1", "to": "tc2", "type": "time"})
+
+
+def _conflicting_constraint(data: Doc) -> None:
+    data["constraints"].append({"from": "to1", "to": "tc2", "type": "space"})
+
+
+def _no_actors(data: Doc) -> None:
+    data["actors"] = []
+
+
+def _actorless_process(data: Doc) -> None:
+    data["processes"].append(_actorless())
+
+
+def _no_workpiece(data: Doc) -> None:
+    del _net(data)["workpiece"]
+
+
 def _two_sinks(data: Doc) -> None:
     _net(data)["places"].append({"id": "p10"})
     _net(data)["arcs"].append(["tc1", "p10"])
@@ -122,6 +144,16 @@ CASES: list[tuple[str, Callable[[Doc], None], str, set[str]]] = [
         {"tc1", "tc3"},
     ),
     ("constraint of an unknown type", _constraint_type, "constraint-type", {"tc1", "to2"}),
+    ("the same constraint twice", _duplicate_constraint, "constraint-duplicate", {"to1", "tc2"}),
+    (
+        "two types on one ordered pair",
+        _conflicting_constraint,
+        "constraint-conflict",
+        {"to1", "tc2"},
+    ),
+    ("a pattern without actors", _no_actors, "no-actors", {"N"}),
+    ("a process without actors", _actorless_process, "no-actors", {"N2"}),
+    ("a process without a workpiece", _no_workpiece, "unassigned-workpiece", {"N"}),
     ("process with two sink places", _two_sinks, "not-workflow-net", {"p9", "p10"}),
     ("node on no path from source to sink", _stray_cycle, "not-workflow-net", {"p10", "t3"}),
     ("declared pattern does not hold", _declared_wrongly, "pattern-mismatch", set()),
@@ -145,6 +177,76 @@ def test_each_broken_rule_is_reported_with_its_code_and_elements(
     assert elements <= set(issue.elements)
     assert len(issue.message) > 20
     assert report.valid is False
+
+
+def _actorless() -> Doc:
+    """A second process of one silent transition, which needs no actor to be a workflow net."""
+    return {
+        "id": "N2",
+        "workpiece": "w2",
+        "actors": [],
+        "places": [{"id": "q1"}, {"id": "q2"}],
+        "transitions": [{"id": "u1"}],
+        "arcs": [["q1", "u1"], ["u1", "q2"]],
+    }
+
+
+NEW_RULES = [
+    (_duplicate_constraint, "constraint-duplicate", ("to1", "tc2")),
+    (_conflicting_constraint, "constraint-conflict", ("to1", "tc2")),
+    (_actorless_process, "no-actors", ("N2",)),
+    (_no_workpiece, "unassigned-workpiece", ("N",)),
+]
+
+
+@pytest.mark.parametrize(("change", "code", "elements"), NEW_RULES, ids=[r[1] for r in NEW_RULES])
+def test_a_model_breaking_one_new_rule_gets_exactly_that_code(
+    change: Callable[[Doc], None], code: str, elements: tuple[str, ...]
+) -> None:
+    report = check_document(_mutated(change))
+
+    assert [(i.code, i.elements) for i in report.errors] == [(code, elements)]
+    assert report.sound is None
+
+
+def test_a_pattern_without_actors_is_an_error_not_just_a_warning() -> None:
+    data = _mutated(_no_actors)
+    for transition in _net(data)["transitions"]:
+        transition.pop("performer", None)
+    _net(data)["actors"] = []
+    data["constraints"] = []
+
+    report = check_document(data)
+
+    assert [(i.code, i.elements) for i in report.errors] == [("no-actors", ("N",))]
+    assert report.errors[0].message.startswith("The pattern has no actors")
+
+
+def test_a_constraint_in_both_directions_is_no_conflict() -> None:
+    report = check_document(two_lanes([("to1", "tc2", "time"), ("tc2", "to2", "space")]))
+
+    codes = {i.code for i in report.errors}
+    assert not codes & {"constraint-conflict", "constraint-duplicate"}, report.as_dict()
+
+
+def test_a_duplicate_constraint_names_its_tasks_and_how_often_it_is_drawn() -> None:
+    data = _labelled(_mutated(_duplicate_constraint))
+    _duplicate_constraint(data)
+
+    issue = next(i for i in check_document(data).errors if i.code == "constraint-duplicate")
+
+    assert issue.message.startswith(
+        "The time constraint “Prepare workpiece” → “Place insert” is drawn 3 times"
+    )
+
+
+def test_a_conflict_names_the_types_on_the_pair() -> None:
+    data = _labelled(_mutated(_conflicting_constraint))
+
+    issue = next(i for i in check_document(data).errors if i.code == "constraint-conflict")
+
+    assert "“Prepare workpiece” → “Place insert”" in issue.message
+    assert "2 types (time, space)" in issue.message
 
 
 def test_the_unmutated_model_breaks_no_rule() -> None:
@@ -253,3 +355,22 @@ def test_an_arc_between_two_places_says_what_to_put_between_them() -> None:
 
     assert issue.message.startswith("The arrow from place p2 to place p3 joins two places")
     assert issue.elements == ("p2", "p3")
+
+
+THESIS_INSTANTIATIONS = sorted(EXAMPLES.glob("*.json"))
+USE_CASES = sorted((EXAMPLES / "use_cases").glob("*.json"))
+
+
+def test_the_shipped_library_has_the_eight_instantiations_and_seven_use_cases() -> None:
+    assert len(THESIS_INSTANTIATIONS) == 8
+    assert len(USE_CASES) >= 7
+
+
+@pytest.mark.parametrize(
+    "path", THESIS_INSTANTIATIONS + USE_CASES, ids=lambda path: f"{path.parent.name}/{path.stem}"
+)
+def test_every_shipped_document_keeps_every_rule(path: Path) -> None:
+    report = check_document(json.loads(path.read_text(encoding="utf-8")))
+
+    assert report.errors == (), report.as_dict()
+    assert report.valid is True

@@ -5,7 +5,7 @@ from django.contrib.auth.models import User
 from django.core.exceptions import ValidationError
 from django.db import connection
 
-from hrc.engine import FormatError, read_pattern
+from hrc.engine import FormatError, check_document, read_pattern
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.patterns import services
@@ -29,6 +29,9 @@ def test_a_pattern_created_without_a_draft_starts_from_a_readable_one(
 ) -> None:
     pattern = services.create_pattern(organisation, name="Blank", created_by=engineer)
     assert read_pattern(pattern.draft).name == "Blank"
+    # Its net works on a workpiece already; what it lacks is what an engineer draws first.
+    codes = [(i.code, i.elements) for i in check_document(pattern.draft).errors]
+    assert codes == [("no-actors", ("N",))]
 
 
 def test_a_draft_the_database_cannot_store_is_refused(organisation: Organisation) -> None:

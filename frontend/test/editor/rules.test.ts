@@ -64,6 +64,12 @@ describe("constraints", () => {
     expect(constraintRefusal(to1, tc1, "order", [])).toBe('Unknown constraint type "order": use time, space or func.');
     expect(constraintRefusal(to1, tc1, "time", [{ from: "to1", to: "tc1", type: "time" }])).toBe("There is already a time constraint from to1 to tc1.");
   });
+
+  test("of one type per ordered pair of tasks", () => {
+    expect(constraintRefusal(to1, tc1, "space", [{ from: "to1", to: "tc1", type: "time" }])).toBe(
+      "There is already a time constraint from to1 to tc1: an ordered pair of tasks has one constraint type (change that one's type instead).",
+    );
+  });
 });
 
 describe("actors and lanes", () => {

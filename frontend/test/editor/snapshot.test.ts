@@ -64,6 +64,6 @@ describe("the canvas snapshot of a document", () => {
   test("an empty model becomes a document with one empty net", () => {
     const document = toDocument(toSnapshot(emptyDocument("Fresh")));
     expect(document).toMatchObject({ format: "hrc-pattern/1", name: "Fresh", actors: [], constraints: [] });
-    expect(document.processes).toEqual([{ id: "N", actors: [], places: [], transitions: [], arcs: [] }]);
+    expect(document.processes).toEqual([{ id: "N", workpiece: "workpiece", actors: [], places: [], transitions: [], arcs: [] }]);
   });
 });

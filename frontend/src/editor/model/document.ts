@@ -91,13 +91,16 @@ export class DocumentError extends Error {
   }
 }
 
+/** What a new process works on until the engineer names it (wpassign is total); the server's drafts say the same. */
+export const DEFAULT_WORKPIECE = "workpiece";
+
 /** A fresh, empty model: one net, no actors yet. */
 export function emptyDocument(name = "New pattern"): PatternDocument {
   return {
     format: FORMAT,
     name,
     actors: [],
-    processes: [{ id: "N", actors: [], places: [], transitions: [], arcs: [] }],
+    processes: [{ id: "N", workpiece: DEFAULT_WORKPIECE, actors: [], places: [], transitions: [], arcs: [] }],
     constraints: [],
   };
 }

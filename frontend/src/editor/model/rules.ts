@@ -56,8 +56,10 @@ export function constraintRefusal(
   if (source.performer === target.performer) {
     return `${source.id} and ${target.id} are both tasks of ${source.performer}: a constraint joins tasks of different actors.`;
   }
-  if (constraints.some((c) => c.from === source.id && c.to === target.id && c.type === type)) {
-    return `There is already a ${type} constraint from ${source.id} to ${target.id}.`;
+  const drawn = constraints.find((c) => c.from === source.id && c.to === target.id);
+  if (drawn?.type === type) return `There is already a ${type} constraint from ${source.id} to ${target.id}.`;
+  if (drawn) {
+    return `There is already a ${drawn.type} constraint from ${source.id} to ${target.id}: an ordered pair of tasks has one constraint type (change that one's type instead).`;
   }
   return null;
 }

@@ -10,6 +10,7 @@ import {
   type ActorData,
   type ConstraintData,
   type DocumentLayout,
+  DEFAULT_WORKPIECE,
   type Extra,
   FORMAT,
   isObject,
@@ -115,7 +116,7 @@ export function toSnapshot(document: PatternDocument): Snapshot {
 export function toDocument(snapshot: Snapshot): PatternDocument {
   const processIds = snapshot.processes.map((meta) => String(meta.id));
   const fallback = processIds[0] ?? "N";
-  const processes: ProcessData[] = (snapshot.processes.length ? snapshot.processes : [{ id: "N", actors: [] }]).map(
+  const processes: ProcessData[] = (snapshot.processes.length ? snapshot.processes : [{ id: "N", workpiece: DEFAULT_WORKPIECE, actors: [] }]).map(
     (meta) => ({
       ...structuredClone(meta),
       id: String(meta.id),

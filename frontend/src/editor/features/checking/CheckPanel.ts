@@ -13,6 +13,7 @@ import { addElement, element } from "../../../shared/dom";
 import type { CheckIssue, CheckReport } from "../../api";
 import type TokenGameMode from "../token-game/TokenGameMode";
 import { listOfNames } from "../../model/words";
+import { issueTargets } from "./targets";
 
 const PATTERN_WORDS: Record<string, string> = {
   synchronized: "Synchronized",
@@ -74,11 +75,12 @@ export default class CheckPanel {
   private item(issue: CheckIssue, severity: "error" | "warning"): HTMLElement {
     const item = element("article", { class: `hrc-issue hrc-${severity}`, "data-code": issue.code }, element("p", "", issue.message));
     const known = issue.elements.filter((id) => this.elementRegistry.get(id));
-    if (known.length) {
-      const show = button(`Show ${listOfNames(known, (id) => this.nameOf(id))}`, item);
-      show.title = `Select ${listOfNames(known, (id) => this.nameOf(id), known.length)} in the drawing`;
+    const elements = issueTargets(issue, this.elementRegistry, this.canvas.getRootElement());
+    if (elements.length) {
+      // A process is not drawn: its issue selects its lanes.
+      const show = button(known.length ? `Show ${listOfNames(known, (id) => this.nameOf(id))}` : "Show its lanes", item);
+      show.title = known.length ? `Select ${listOfNames(known, (id) => this.nameOf(id), known.length)} in the drawing` : "Select the lanes of the process in the drawing";
       show.addEventListener("click", () => {
-        const elements = known.map((id) => this.elementRegistry.get(id)).filter((e) => e !== undefined);
         this.selection.select(elements);
         this.canvas.scrollToElement(elements[0] as never);
       });

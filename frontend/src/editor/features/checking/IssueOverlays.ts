@@ -1,6 +1,6 @@
 /**
- * The check's errors and warnings on the elements they name: a marker on the
- * element and a badge whose tooltip is the message.
+ * The check's errors and warnings on the elements they name (see targets.ts):
+ * a marker on the element and a badge whose tooltip is the message.
  */
 
 import type Canvas from "diagram-js/lib/core/Canvas";
@@ -9,6 +9,7 @@ import type EventBus from "diagram-js/lib/core/EventBus";
 import type Overlays from "diagram-js/lib/features/overlays/Overlays";
 
 import type { CheckIssue, CheckReport } from "../../api";
+import { issueTargets } from "./targets";
 
 const TYPE = "hrc-issue";
 
@@ -30,10 +31,10 @@ export default class IssueOverlays {
   show(report: CheckReport): void {
     this.clear();
     const byElement = new Map<string, { severity: "error" | "warning"; issues: CheckIssue[] }>();
+    const root = this.canvas.getRootElement();
     const collect = (issues: CheckIssue[], severity: "error" | "warning") => {
       for (const issue of issues) {
-        for (const id of new Set(issue.elements)) {
-          if (!this.elementRegistry.get(id)) continue;
+        for (const { id } of issueTargets(issue, this.elementRegistry, root)) {
           const entry = byElement.get(id) ?? { severity, issues: [] };
           entry.issues.push(issue);
           byElement.set(id, entry);

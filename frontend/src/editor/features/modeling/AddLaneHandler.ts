@@ -9,7 +9,7 @@ import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
 import type { CommandContext } from "diagram-js/lib/command/CommandStack";
 import type { Shape } from "diagram-js/lib/model/Types";
 
-import type { ActorType, Extra } from "../../model/document";
+import { type ActorType, DEFAULT_WORKPIECE, type Extra } from "../../model/document";
 import { nextId } from "../../model/ids";
 import { LANE_HEIGHT } from "../../model/snapshot";
 import { isLane, type LaneObject, objectOf, type RootObject } from "../../core/elements";
@@ -52,7 +52,7 @@ export default class AddLaneHandler {
     const coexistence = processes.length > 1 && processes.every((process) => actorsOf(process) === 1);
     if (!coexistence) return String(processes[0].id);
     const id = nextId("process", this.elementFactory.isTaken);
-    this.modeling.updateData(root, {}, { processes: [...processes, { id, actors: [] }] });
+    this.modeling.updateData(root, {}, { processes: [...processes, { id, workpiece: DEFAULT_WORKPIECE, actors: [] }] });
     return id;
   }
 }
