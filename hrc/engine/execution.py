@@ -150,7 +150,8 @@ def possible_firings(net: Net, marking: Marking) -> list[Firing]:
 
 
 def _merged(arcs: list[tuple[str, int]]) -> list[tuple[str, int]]:
-    """Adds up parallel arcs to the same place (the same constraint written twice)."""
+    """Adds up parallel arcs to the same place. A model checked now has none (constraint-duplicate
+    refuses a constraint written twice), but a version published before that rule keeps running."""
     weights: dict[str, int] = {}
     for place, weight in arcs:
         weights[place] = weights.get(place, 0) + weight
