@@ -5,6 +5,11 @@ waits in a case until a message of its name arrives whose correlation keys
 equal the case's values for them. A message that finds no waiting case is
 kept until it expires; a case that starts waiting takes the oldest matching
 one. The sender's message id makes a repeated send harmless.
+
+A case sends messages too (a `send` key): progress.send_message writes the row
+in the transaction that fires the sending transition, and deliver_sent_message
+offers it to the other cases after commit, through the same _deliver as one
+from outside, so no case is locked while the sender's lock is held.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ from hrc.errors import Conflict, Invalid
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
 
-DEFAULT_TTL_SECONDS = 3600
+DEFAULT_TTL_SECONDS = progress.MESSAGE_TTL_SECONDS
 MAX_TTL_SECONDS = 7 * 24 * 3600
 
 
@@ -108,6 +113,16 @@ def _deliver(message: Message) -> None:
                 progress.advance(case, net)
                 case.save()
                 return
+
+
+def deliver_sent_message(message_pk: int) -> None:
+    """Offers a message a case sent to the cases waiting for it; nothing when one took it
+    already (its own case, or this task run before), or it expired."""
+    message = Message.objects.filter(
+        pk=message_pk, consumed_at__isnull=True, expires_at__gt=timezone.now()
+    ).first()
+    if message is not None:
+        _deliver(message)
 
 
 def purge_expired_messages() -> int:
