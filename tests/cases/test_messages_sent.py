@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 from django.contrib.auth.models import User
 from django.db import transaction
+from django.test import Client
 from django.utils import timezone
 
 from hrc.cases import services
@@ -291,3 +292,36 @@ def test_a_send_that_fails_on_the_case_data_refuses_the_completion_naming_it(
     with pytest.raises(Invalid, match="The message 'part-ready' that prepare sends failed"):
         services.complete_work_item(item, user=operator)
     assert not Message.objects.exists()
+
+
+@pytest.mark.django_db(transaction=True)
+def test_the_case_page_shows_what_a_case_sent_and_who_took_it(
+    publish: Callable[..., PatternVersion], operator: User, engineer: User, outsider: User
+) -> None:
+    receiver = _waiting_receiver(publish(factories.message_document()), operator, "F-1")
+    sender = _start(publish(_sender_document()), operator, order="F-1", part=6)
+    _do(sender, "prepare", operator)
+    message = Message.objects.get()
+    supervisor = Client()
+    supervisor.force_login(engineer)
+
+    waiting = _messages_section(supervisor, sender)
+    assert "part-ready" in waiting
+    assert message.message_id in waiting
+    assert "waiting" in waiting
+    deliver_sent_message(message.pk)
+    sent = _messages_section(supervisor, sender)
+    assert f"arrive of case {receiver.pk}" in sent
+    taken = _messages_section(supervisor, receiver)
+    assert f"prepare of case {sender.pk}" in taken
+    assert "{&quot;order&quot;: &quot;F-1&quot;}" in taken
+    stranger = Client()
+    stranger.force_login(outsider)
+    assert stranger.get(f"/cases/{sender.pk}/").status_code == 404
+
+
+def _messages_section(client: Client, case: Case) -> str:
+    response = client.get(f"/cases/{case.pk}/")
+    assert response.status_code == 200
+    page = response.content.decode()
+    return page[page.index('id="messages"') : page.index('id="timeline"')]
