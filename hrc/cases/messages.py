@@ -22,8 +22,9 @@ from django.contrib.auth.models import User
 from django.db import IntegrityError, transaction
 from django.utils import timezone
 
-from hrc.cases import progress
+from hrc.cases import dispatch, progress
 from hrc.cases.choices import CaseStatus
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, Message
 from hrc.cases.nets import case_net
 from hrc.errors import Conflict, Invalid
@@ -117,12 +118,31 @@ def _deliver(message: Message) -> None:
 
 def deliver_sent_message(message_pk: int) -> None:
     """Offers a message a case sent to the cases waiting for it; nothing when one took it
-    already (its own case, or this task run before), or it expired."""
+    already (its own case, or this task run before), or it expired. A case that comes to
+    wait for it later takes it itself (progress.advance)."""
     message = Message.objects.filter(
         pk=message_pk, consumed_at__isnull=True, expires_at__gt=timezone.now()
     ).first()
     if message is not None:
         _deliver(message)
+    Message.objects.filter(pk=message_pk, offered_at__isnull=True).update(offered_at=timezone.now())
+
+
+def sweep_sent_messages(grace_seconds: float = 2.0) -> int:
+    """Rings again for the messages cases sent that were never offered: their doorbell was
+    lost (the broker restarted), and a case already waiting would wait for ever. Returns how
+    many."""
+    now = timezone.now()
+    lost = list(
+        Message.objects.filter(
+            sent_from_case__isnull=False, offered_at__isnull=True, consumed_at__isnull=True,
+            expires_at__gt=now, received_at__lt=now - dt.timedelta(seconds=grace_seconds),
+        ).values_list("pk", flat=True)[:100]
+    )  # fmt: skip
+    with transaction.atomic():  # send_on_commit needs a transaction to wait for
+        for message_pk in lost:
+            dispatch.send_on_commit(Task.DELIVER_MESSAGE, message_pk)
+    return len(lost)
 
 
 def purge_expired_messages() -> int:

@@ -292,6 +292,9 @@ class Message(models.Model):
         Case, on_delete=models.SET_NULL, null=True, blank=True, related_name="sent_messages"
     )
     sent_from_transition = models.CharField(max_length=200, blank=True)
+    # When a case's message was offered to the other cases after its sender committed; until
+    # then the sweeper rings for it again (its doorbell may have been lost).
+    offered_at = models.DateTimeField(null=True, blank=True)
 
     class Meta:
         ordering = ["received_at", "id"]

@@ -9,7 +9,7 @@ from celery import shared_task
 
 from hrc.cases import interruptions, jobs
 from hrc.cases.dispatch import Task
-from hrc.cases.messages import deliver_sent_message, purge_expired_messages
+from hrc.cases.messages import deliver_sent_message, purge_expired_messages, sweep_sent_messages
 
 
 @shared_task(name=Task.RUN_JOB.value, ignore_result=True)
@@ -20,7 +20,7 @@ def run_job(job_id: int) -> None:
 
 @shared_task(name=Task.SWEEP.value, ignore_result=True)
 def sweep() -> dict[str, int]:
-    return jobs.sweep()
+    return {**jobs.sweep(), "messages": sweep_sent_messages()}
 
 
 @shared_task(name=Task.INTERRUPT_COBOT.value, ignore_result=True)

@@ -325,3 +325,28 @@ def _messages_section(client: Client, case: Case) -> str:
     assert response.status_code == 200
     page = response.content.decode()
     return page[page.index('id="messages"') : page.index('id="timeline"')]
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_lost_delivery_doorbell_is_rung_again_by_the_sweeper(
+    publish: Callable[..., PatternVersion],
+    operator: User,
+    start_worker: Callable[..., WorkerProcess],
+) -> None:
+    receiver = _waiting_receiver(publish(factories.message_document()), operator, "G-1")
+    sender = _start(publish(_sender_document()), operator, order="G-1", part=8)
+    original = app.send_task
+    app.send_task = lambda *args, **kwargs: None  # type: ignore[method-assign]  # the broker is down
+    try:
+        _do(sender, "prepare", operator)
+    finally:
+        app.send_task = original  # type: ignore[method-assign]
+    message = Message.objects.get()
+    assert (message.offered_at, message.consumed_at) == (None, None)
+
+    start_worker(beat=True)  # the beat's sweeper finds it
+
+    until(lambda: _offered(receiver) == ["assemble"], timeout=30, message="never delivered")
+    message.refresh_from_db()
+    assert message.case == receiver
+    assert message.offered_at is not None
