@@ -345,17 +345,22 @@ def _message_rows(case: Case, messages: Iterable[Message]) -> list[MessageRow]:
     rows = []
     for message in messages:
         source = message.sent_from_case
-        if source is None:
-            sender = "from outside"
-        else:
-            sender = message.sent_from_transition + ("" if source == case else f" of case {source.pk}")
+        sender = (
+            _transition_of(message.sent_from_transition, source, case)
+            if source is not None
+            else "from outside"
+        )
         if message.case is not None:
-            taker = message.transition + ("" if message.case == case else f" of case {message.case.pk}")
+            taker = _transition_of(message.transition, message.case, case)
         else:
             taker = "waiting" if message.expires_at > now else "expired, nobody took it"
         keys = json.dumps(message.correlation, sort_keys=True)
         rows.append(MessageRow(message, source == case, sender, taker, keys))
     return rows
+
+
+def _transition_of(transition: str, of: Case, this: Case) -> str:
+    return transition if of == this else f"{transition} of case {of.pk}"
 
 
 def format_duration(seconds: float) -> str:

@@ -17,7 +17,7 @@ from hrc.cases import services
 from hrc.cases.choices import CaseStatus, EventType
 from hrc.cases.dispatch import Task, registered
 from hrc.cases.messages import deliver_sent_message, purge_expired_messages
-from hrc.cases.models import Case, Message
+from hrc.cases.models import Case, Message, WorkItem
 from hrc.celery import app
 from hrc.errors import Invalid
 from hrc.organisations.choices import Role
@@ -185,29 +185,31 @@ def test_a_message_to_another_process_of_the_same_case_is_taken_in_the_same_tran
 
 @pytest.mark.django_db(transaction=True)
 def test_a_completion_rolled_back_and_done_again_sends_one_message(
-    publish: Callable[..., PatternVersion], operator: User
+    publish: Callable[..., PatternVersion], operator: User, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     sender = _start(publish(_sender_document()), operator, order="B-1", part=1)
     item = factories.open_work_item(sender, "prepare")
     services.start_work_item(item, user=operator)
     sent_tasks: list[Any] = []
-    original = app.send_task
-    app.send_task = lambda name, *args, **kwargs: sent_tasks.append((name, args))  # type: ignore[method-assign]
-    try:
-        with pytest.raises(RuntimeError), transaction.atomic():
-            services.complete_work_item(item, user=operator)
-            assert Message.objects.count() == 1
-            raise RuntimeError("the connection dropped before the commit")
-        assert not Message.objects.exists()
-        assert sent_tasks == []  # nothing is delivered of a firing that never was
-        services.complete_work_item(item, user=operator)
-    finally:
-        app.send_task = original  # type: ignore[method-assign]
+    monkeypatch.setattr(app, "send_task", lambda name, *args, **kwargs: sent_tasks.append(name))
+
+    with pytest.raises(RuntimeError, match="dropped"):
+        _complete_and_roll_back(item, operator)
+    assert not Message.objects.exists()
+    assert sent_tasks == []  # nothing is delivered of a firing that never was
+    services.complete_work_item(item, user=operator)
 
     message = Message.objects.get()
     sent = sender.events.get(type=EventType.MESSAGE_SENT)
     assert message.message_id == f"case:{sender.pk}:prepare:{sent.seq}"
-    assert [name for name, _ in sent_tasks] == [Task.DELIVER_MESSAGE.value]
+    assert sent_tasks == [Task.DELIVER_MESSAGE.value]
+
+
+def _complete_and_roll_back(item: WorkItem, operator: User) -> None:
+    with transaction.atomic():
+        services.complete_work_item(item, user=operator)
+        assert Message.objects.count() == 1
+        raise RuntimeError("the connection dropped before the commit")
 
 
 @pytest.mark.django_db(transaction=True)
@@ -332,15 +334,13 @@ def test_a_lost_delivery_doorbell_is_rung_again_by_the_sweeper(
     publish: Callable[..., PatternVersion],
     operator: User,
     start_worker: Callable[..., WorkerProcess],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     receiver = _waiting_receiver(publish(factories.message_document()), operator, "G-1")
     sender = _start(publish(_sender_document()), operator, order="G-1", part=8)
-    original = app.send_task
-    app.send_task = lambda *args, **kwargs: None  # type: ignore[method-assign]  # the broker is down
-    try:
+    with monkeypatch.context() as broker_down:
+        broker_down.setattr(app, "send_task", lambda *args, **kwargs: None)
         _do(sender, "prepare", operator)
-    finally:
-        app.send_task = original  # type: ignore[method-assign]
     message = Message.objects.get()
     assert (message.offered_at, message.consumed_at) == (None, None)
 

@@ -12,7 +12,11 @@ from tests.engine.test_taskconfig import _doc, _silent
 SYNC = {
     "name": "sync1",
     "correlation": {"case": "=case.id", "order": "=data.order"},
-    "payload": {"part": "=data.part", "ready": True, "poses": ["=data.pose", [1, "=case.reference"]]},
+    "payload": {
+        "part": "=data.part",
+        "ready": True,
+        "poses": ["=data.pose", [1, "=case.reference"]],
+    },
 }
 
 
@@ -56,7 +60,10 @@ def test_a_message_transition_may_send_as_it_fires() -> None:
         ({"name": "m", "to": "p2"}, "'send' has no key 'to'"),
         ({"name": "m", "correlation": ["case"]}, "the 'send' 'correlation' must map keys"),
         ({"name": "m", "payload": "=data"}, "the 'send' 'payload' must map keys"),
-        ({"name": "m", "correlation": {"k": "=result.x"}}, "send correlation 'k': unknown name 'result'"),
+        (
+            {"name": "m", "correlation": {"k": "=result.x"}},
+            "send correlation 'k': unknown name 'result'",
+        ),
         ({"name": "m", "payload": {"k": ["=data.a +"]}}, "send payload 'k':"),
         ({"name": "m", "payload": {"k": {"deep": "=item.x"}}}, "unknown name 'item'"),
     ],
