@@ -109,9 +109,7 @@ def _deliver(message: Message) -> None:
             case = progress.lock_case(case_id)
             if case.status != CaseStatus.RUNNING:
                 continue
-            net = case_net(case.version)
-            if progress.take_buffered_message(case, net, only=message.pk):
-                progress.advance(case, net)
+            if progress.take_message(case, case_net(case.version), message.pk):
                 case.save()
                 return
 

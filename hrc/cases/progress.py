@@ -370,10 +370,23 @@ def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> 
                     case, EventType.MESSAGE_RECEIVED, task=transition, before=before, after=after,
                     detail={"message": message.message_id, "name": message.name},
                 )  # fmt: skip
-                if transition in net.sends:
-                    _send_or_fail(case, net, transition)
+                if transition in net.sends:  # a RuntimeFault fails the case (advance, take)
+                    send_message(case, _outgoing(case, net, transition), transition)
                 return True
     return False
+
+
+def take_message(case: Case, net: CaseNet, message_pk: int) -> bool:
+    """Offers the case one message (a delivery): when a waiting message transition takes it,
+    the case advances. Call while holding the case row lock. Returns whether it was taken."""
+    try:
+        taken = take_buffered_message(case, net, only=message_pk)
+    except RuntimeFault as fault:  # what the receiving transition sends failed
+        fail_case(case, str(fault))
+        return True
+    if taken:
+        advance(case, net)
+    return taken
 
 
 def case_names(case: Case) -> dict[str, Any]:
@@ -383,14 +396,6 @@ def case_names(case: Case) -> dict[str, Any]:
 
 def _outgoing(case: Case, net: CaseNet, transition: str) -> Outgoing:
     return outgoing(transition, net.sends[transition], case.data, case_names(case))
-
-
-def _send_or_fail(case: Case, net: CaseNet, transition: str) -> None:
-    # Outside advance()'s loop (a delivery takes the message): a failing send fails the case here.
-    try:
-        send_message(case, _outgoing(case, net, transition), transition)
-    except RuntimeFault as fault:
-        fail_case(case, str(fault))
 
 
 def send_message(case: Case, message: Outgoing, transition: str) -> Message:

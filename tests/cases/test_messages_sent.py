@@ -16,7 +16,7 @@ from django.utils import timezone
 from hrc.cases import services
 from hrc.cases.choices import CaseStatus, EventType
 from hrc.cases.dispatch import Task, registered
-from hrc.cases.messages import deliver_sent_message, purge_expired_messages
+from hrc.cases.messages import deliver_sent_message, purge_expired_messages, receive_message
 from hrc.cases.models import Case, Message, WorkItem
 from hrc.celery import app
 from hrc.errors import Invalid
@@ -349,4 +349,26 @@ def test_a_lost_delivery_doorbell_is_rung_again_by_the_sweeper(
     until(lambda: _offered(receiver) == ["assemble"], timeout=30, message="never delivered")
     message.refresh_from_db()
     assert message.case == receiver
-    assert message.offered_at is not None
+    # Marked offered once the delivery is over, so no sweep rings for it again.
+    until(lambda: Message.objects.filter(offered_at__isnull=False).exists(), timeout=10)
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_message_transition_whose_send_fails_fails_its_case_with_an_incident(
+    publish: Callable[..., PatternVersion], operator: User, organisation: Organisation
+) -> None:
+    document = factories.message_document()
+    [arrive] = [t for t in document["processes"][0]["transitions"] if t["id"] == "arrive"]
+    arrive["send"] = {"name": "passed-on", "payload": {"part": "=data.part.id"}}
+    receiver = _waiting_receiver(publish(document), operator, "H-1")
+
+    receive_message(
+        organisation, message_id="m-h1", name="part-ready", correlation={"order": "H-1"},
+        payload={"part": "no id"},
+    )  # fmt: skip
+
+    receiver.refresh_from_db()
+    assert receiver.status == CaseStatus.FAILED
+    [incident] = receiver.incidents.all()
+    assert "The message 'passed-on' that arrive sends failed" in incident.message
+    assert Message.objects.filter(name="passed-on").count() == 0
