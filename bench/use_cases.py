@@ -1,4 +1,4 @@
-"""`make bench` (fifth part): the seven use cases — each one's cycle time against its task times.
+"""`make bench` (fifth part): the use cases — each one's cycle time against its task times.
 
 Every use case of hrc/patterns/examples/use_cases/ runs as `run_pattern
 --simulate` runs it, but on real Celery workers (two, prefork, concurrency
@@ -8,7 +8,8 @@ migrated, dropped), against simulated OPC UA gateways at --time-scale (0.1:
 robot time ten times faster) and simulated operators who complete a task
 0.2–1.0 s of robot time after it starts. A round is one case, or one case
 per operator where the model says its cases differ (the extended spot
-taping runs both operators' cases at once); --rounds rounds per use case.
+taping's queue variant runs both operators' cases at once; the thesis' one
+has both operators' processes in one case); --rounds rounds per use case.
 
 From each case's event log:
 
@@ -66,7 +67,7 @@ class Settings:
     time_scale: float = 0.1
     rounds: int = 3
     workers: int = 2
-    only: tuple[str, ...] = ()  # file stems; empty: all seven
+    only: tuple[str, ...] = ()  # file stems or numbers ("2", "2b"); empty: all of them
     quick: bool = False
     results_dir: Path = field(default=RESULTS_DIR, compare=False)
 

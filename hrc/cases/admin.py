@@ -129,7 +129,10 @@ class CaseEventAdmin(ReadOnlyAdmin):
 
 @admin.register(Message)
 class MessageAdmin(ReadOnlyAdmin):
-    list_display = ["message_id", "name", "organisation", "received_at", "case", "consumed_at"]
+    list_display = [
+        "message_id", "name", "organisation", "received_at", "sent_from_case", "case",
+        "consumed_at",
+    ]  # fmt: skip
     list_filter = ["organisation", "name"]
     search_fields = ["message_id", "name"]
-    list_select_related = ["organisation", "case"]
+    list_select_related = ["organisation", "case", "sent_from_case"]

@@ -92,6 +92,8 @@ class EventType(models.TextChoices):
     TASK_RESUMED = "task-resumed", "Task resumed"
     # A silent (routing) transition fired.
     TRANSITION_FIRED = "transition-fired", "Transition fired"
+    # The case sent a message as a task completed or a transition fired (a "send" key).
+    MESSAGE_SENT = "message-sent", "Message sent"
     MESSAGE_RECEIVED = "message-received", "Message received"
     STEP_RETRY = "step-retry", "Step will be retried"
     # A cobot step or device call failed for good: its error; an incident follows.

@@ -45,6 +45,7 @@ class Task(StrEnum):
     INTERRUPT_COBOT = "hrc.cases.tasks.interrupt_cobot"
     RESUME_COBOT = "hrc.cases.tasks.resume_cobot"
     PURGE_MESSAGES = "hrc.cases.tasks.purge_messages"
+    DELIVER_MESSAGE = "hrc.cases.tasks.deliver_message"
 
 
 def send_on_commit(task: Task, *args: Any, countdown: float = 0) -> None:

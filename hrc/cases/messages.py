@@ -5,6 +5,11 @@ waits in a case until a message of its name arrives whose correlation keys
 equal the case's values for them. A message that finds no waiting case is
 kept until it expires; a case that starts waiting takes the oldest matching
 one. The sender's message id makes a repeated send harmless.
+
+A case sends messages too (a `send` key): progress.send_message writes the row
+in the transaction that fires the sending transition, and deliver_sent_message
+offers it to the other cases after commit, through the same _deliver as one
+from outside, so no case is locked while the sender's lock is held.
 """
 
 from __future__ import annotations
@@ -17,15 +22,16 @@ from django.contrib.auth.models import User
 from django.db import IntegrityError, transaction
 from django.utils import timezone
 
-from hrc.cases import progress
+from hrc.cases import dispatch, progress
 from hrc.cases.choices import CaseStatus
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, Message
 from hrc.cases.nets import case_net
 from hrc.errors import Conflict, Invalid
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
 
-DEFAULT_TTL_SECONDS = 3600
+DEFAULT_TTL_SECONDS = progress.MESSAGE_TTL_SECONDS
 MAX_TTL_SECONDS = 7 * 24 * 3600
 
 
@@ -103,11 +109,38 @@ def _deliver(message: Message) -> None:
             case = progress.lock_case(case_id)
             if case.status != CaseStatus.RUNNING:
                 continue
-            net = case_net(case.version)
-            if progress.take_buffered_message(case, net, only=message.pk):
-                progress.advance(case, net)
+            if progress.take_message(case, case_net(case.version), message.pk):
                 case.save()
                 return
+
+
+def deliver_sent_message(message_pk: int) -> None:
+    """Offers a message a case sent to the cases waiting for it; nothing when one took it
+    already (its own case, or this task run before), or it expired. A case that comes to
+    wait for it later takes it itself (progress.advance)."""
+    message = Message.objects.filter(
+        pk=message_pk, consumed_at__isnull=True, expires_at__gt=timezone.now()
+    ).first()
+    if message is not None:
+        _deliver(message)
+    Message.objects.filter(pk=message_pk, offered_at__isnull=True).update(offered_at=timezone.now())
+
+
+def sweep_sent_messages(grace_seconds: float = 2.0) -> int:
+    """Rings again for the messages cases sent that were never offered: their doorbell was
+    lost (the broker restarted), and a case already waiting would wait for ever. Returns how
+    many."""
+    now = timezone.now()
+    lost = list(
+        Message.objects.filter(
+            sent_from_case__isnull=False, offered_at__isnull=True, consumed_at__isnull=True,
+            expires_at__gt=now, received_at__lt=now - dt.timedelta(seconds=grace_seconds),
+        ).values_list("pk", flat=True)[:100]
+    )  # fmt: skip
+    with transaction.atomic():  # send_on_commit needs a transaction to wait for
+        for message_pk in lost:
+            dispatch.send_on_commit(Task.DELIVER_MESSAGE, message_pk)
+    return len(lost)
 
 
 def purge_expired_messages() -> int:

@@ -267,7 +267,8 @@ class CaseEvent(models.Model):
 
 
 class Message(models.Model):
-    """A message sent to cases (POST /api/messages/); kept until consumed or expired."""
+    """A message sent to cases (POST /api/messages/, or by a case's `send`); kept until
+    consumed or expired."""
 
     organisation = models.ForeignKey(
         Organisation, on_delete=models.CASCADE, related_name="messages"
@@ -286,6 +287,14 @@ class Message(models.Model):
     transition = models.CharField(max_length=200, blank=True)
     consumed_at = models.DateTimeField(null=True, blank=True)
     sent_by = models.ForeignKey(_USER, on_delete=models.SET_NULL, null=True, related_name="+")
+    # A message a case sent (sent_by is then null), and the transition that sent it.
+    sent_from_case = models.ForeignKey(
+        Case, on_delete=models.SET_NULL, null=True, blank=True, related_name="sent_messages"
+    )
+    sent_from_transition = models.CharField(max_length=200, blank=True)
+    # When a case's message was offered to the other cases after its sender committed; until
+    # then the sweeper rings for it again (its doorbell may have been lost).
+    offered_at = models.DateTimeField(null=True, blank=True)
 
     class Meta:
         ordering = ["received_at", "id"]

@@ -12,6 +12,7 @@ interruption row.
 
 from __future__ import annotations
 
+import datetime as dt
 from collections.abc import Mapping
 from typing import Any
 
@@ -37,13 +38,24 @@ from hrc.cases.models import Case, Incident, Interruption, Job, Message, WorkIte
 from hrc.cases.selectors import performable_by
 from hrc.engine.commands import cobot_command
 from hrc.engine.petri import Marking
-from hrc.engine.runtime import CaseNet, NotEnabled, RuntimeFault, apply_outputs, correlates
+from hrc.engine.runtime import (
+    CaseNet,
+    NotEnabled,
+    Outgoing,
+    RuntimeFault,
+    apply_outputs,
+    correlates,
+    outgoing,
+)
 from hrc.engine.taskconfig import TaskConfig
 from hrc.errors import Conflict, Invalid, NotAllowed, NotFound
 
 # advance() repeats settle → messages → held completions until nothing changes;
 # each round consumes a token or a message, so a sound net stops long before this.
 MAX_ROUNDS = 10_000
+# How long a message waits for a case to take it: one from outside unless it says otherwise,
+# and every message a case sends.
+MESSAGE_TTL_SECONDS = 3600
 
 
 # The locks every writer takes first -------------------------------------------------
@@ -143,6 +155,9 @@ def _settle(case: Case, net: CaseNet) -> bool:
             case, EventType.TRANSITION_FIRED, task=transition, before=marking, after=after_one
         )
         marking = after_one
+        case.marking = dict(marking)
+        if transition in net.sends:
+            send_message(case, _outgoing(case, net, transition), transition)
     case.marking = dict(after)
     return bool(fired)
 
@@ -267,6 +282,7 @@ def complete_task(
     after = net.complete(before, item.task)
     try:
         case.data = apply_outputs(net.tasks[item.task], item.task, result, case.data)
+        message = _outgoing(case, net, item.task) if item.task in net.sends else None
     except RuntimeFault as fault:
         raise Invalid(str(fault)) from None
     case.marking = dict(after)
@@ -274,6 +290,8 @@ def complete_task(
     item.result, item.completed_by = dict(result), user
     item.save(update_fields=["state", "ended_at", "result", "completed_by", "started_at"])
     record_event(case, EventType.TASK_COMPLETED, item=item, user=user, before=before, after=after)
+    if message is not None:
+        send_message(case, message, item.task)
     if item.task in net.space_tasks:  # only a space constraint's tasks are ever interrupted
         _end_interruptions(case, Q(work_item=item) | Q(operator_work_item=item))
 
@@ -338,7 +356,9 @@ def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> 
         messages = messages.filter(pk=only)
     for message in messages.order_by("received_at", "id")[:100]:
         for transition, config in waiting:
-            if config.name == message.name and correlates(config, case.data, message.correlation):
+            if config.name == message.name and correlates(
+                config, case.data, message.correlation, case_names(case)
+            ):
                 before = Marking(case.marking)
                 after = net.receive(before, transition)
                 case.marking = dict(after)
@@ -350,8 +370,51 @@ def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> 
                     case, EventType.MESSAGE_RECEIVED, task=transition, before=before, after=after,
                     detail={"message": message.message_id, "name": message.name},
                 )  # fmt: skip
+                if transition in net.sends:  # a RuntimeFault fails the case (advance, take)
+                    send_message(case, _outgoing(case, net, transition), transition)
                 return True
     return False
+
+
+def take_message(case: Case, net: CaseNet, message_pk: int) -> bool:
+    """Offers the case one message (a delivery): when a waiting message transition takes it,
+    the case advances. Call while holding the case row lock. Returns whether it was taken."""
+    try:
+        taken = take_buffered_message(case, net, only=message_pk)
+    except RuntimeFault as fault:  # what the receiving transition sends failed
+        fail_case(case, str(fault))
+        return True
+    if taken:
+        advance(case, net)
+    return taken
+
+
+def case_names(case: Case) -> dict[str, Any]:
+    """What message expressions read as `case`."""
+    return {"id": case.pk, "reference": case.reference}
+
+
+def _outgoing(case: Case, net: CaseNet, transition: str) -> Outgoing:
+    return outgoing(transition, net.sends[transition], case.data, case_names(case))
+
+
+def send_message(case: Case, message: Outgoing, transition: str) -> Message:
+    """Puts the message a case sends in the outbox: a row that commits with the firing or not at
+    all. Its id is the case's, the transition's and the event's number, so a transaction run
+    again after a rollback writes the same id and one that committed can never be repeated.
+    Another process of this case takes it in advance()'s loop; other cases after commit."""
+    message_id = f"case:{case.pk}:{transition}:{case.last_seq + 1}"  # the event's number
+    record_event(case, EventType.MESSAGE_SENT, task=transition, detail={
+        "message": message_id, "name": message.name, "correlation": message.correlation,
+    })  # fmt: skip
+    row = Message.objects.create(
+        organisation_id=case.organisation_id, message_id=message_id, name=message.name,
+        correlation=message.correlation, payload=message.payload,
+        expires_at=timezone.now() + dt.timedelta(seconds=MESSAGE_TTL_SECONDS),
+        sent_from_case=case, sent_from_transition=transition,
+    )  # fmt: skip
+    dispatch.send_on_commit(Task.DELIVER_MESSAGE, row.pk)
+    return row
 
 
 def _interrupt_shared_space(case: Case, net: CaseNet, operator_item: WorkItem) -> None:

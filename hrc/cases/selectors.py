@@ -25,7 +25,7 @@ from django.db.models import (
 from django.db.models.functions import Coalesce
 
 from hrc.cases.choices import OPEN_WORK_ITEM_STATES, JobState, WorkItemKind, WorkItemState
-from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, Message, WorkItem
 from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.organisations.models import Team
@@ -285,6 +285,15 @@ def interruptions_of(case: Case) -> QuerySet[Interruption]:
         Interruption.objects.filter(case=case)
         .select_related("work_item", "operator_work_item", "cobot")
         .order_by("started_at", "id")
+    )
+
+
+def messages_of(case: Case) -> QuerySet[Message]:
+    """The messages the case sent or took, in the order they were sent, with the other case."""
+    return (
+        Message.objects.filter(Q(sent_from_case=case) | Q(case=case))
+        .select_related("case", "sent_from_case")
+        .order_by("received_at", "id")
     )
 
 

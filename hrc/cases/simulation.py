@@ -69,7 +69,11 @@ REPORTED = {
     "task-interrupted",
     "task-resumed",
     "case-completed",
+    # what a case's processes tell each other or other cases ("send" and "message" keys)
+    "message-sent",
+    "message-received",
 }
+MESSAGES = {"message-sent", "message-received"}
 FAILED = {"case-failed", "case-cancelled"}
 
 
@@ -81,9 +85,10 @@ class RunEvent:
     task: str | None
     actor: str | None
     event: str
+    message: str | None = None  # a message event's message name
 
     def as_dict(self) -> dict[str, Any]:
-        return {
+        event = {
             "seq": self.seq,
             "at": self.at,
             "case": self.case,
@@ -91,6 +96,9 @@ class RunEvent:
             "actor": self.actor,
             "event": self.event,
         }
+        if self.message is not None:
+            event["message"] = self.message
+        return event
 
 
 @dataclass(frozen=True)
@@ -364,9 +372,9 @@ class Simulation:
         """The run's events in time order, numbered; an unfinished case gets case-failed."""
         rows = CaseEvent.objects.filter(case_id__in=case_ids).order_by("at", "case_id", "seq")
         ended: set[int] = set()
-        events: list[tuple[dt.datetime, int, str | None, str | None, str]] = []
-        for row in rows.values_list("at", "case_id", "task", "actor", "type"):
-            at, case, task, actor, kind = row
+        events: list[tuple[dt.datetime, int, str | None, str | None, str, str | None]] = []
+        for row in rows.values_list("at", "case_id", "task", "actor", "type", "detail"):
+            at, case, task, actor, kind, detail = row
             if kind in FAILED:
                 kind = "case-failed"
             if kind not in REPORTED and kind != "case-failed":
@@ -374,13 +382,14 @@ class Simulation:
             if kind.startswith("case-"):
                 ended.add(case)
                 task = actor = ""
-            events.append((at, case, task or None, actor or None, kind))
+            name = detail.get("name") if kind in MESSAGES else None
+            events.append((at, case, task or None, actor or None, kind, name))
         for case in case_ids:
             if case not in ended:
-                events.append((timezone.now(), case, None, None, "case-failed"))
+                events.append((timezone.now(), case, None, None, "case-failed", None))
         return [
-            RunEvent(seq, at.isoformat(), case, task, actor, kind)
-            for seq, (at, case, task, actor, kind) in enumerate(events, start=1)
+            RunEvent(seq, at.isoformat(), case, task, actor, kind, name)
+            for seq, (at, case, task, actor, kind, name) in enumerate(events, start=1)
         ]
 
 

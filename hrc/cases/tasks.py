@@ -9,7 +9,7 @@ from celery import shared_task
 
 from hrc.cases import interruptions, jobs
 from hrc.cases.dispatch import Task
-from hrc.cases.messages import purge_expired_messages
+from hrc.cases.messages import deliver_sent_message, purge_expired_messages, sweep_sent_messages
 
 
 @shared_task(name=Task.RUN_JOB.value, ignore_result=True)
@@ -20,7 +20,7 @@ def run_job(job_id: int) -> None:
 
 @shared_task(name=Task.SWEEP.value, ignore_result=True)
 def sweep() -> dict[str, int]:
-    return jobs.sweep()
+    return {**jobs.sweep(), "messages": sweep_sent_messages()}
 
 
 @shared_task(name=Task.INTERRUPT_COBOT.value, ignore_result=True)
@@ -36,3 +36,9 @@ def resume_cobot(interruption_id: int) -> None:
 @shared_task(name=Task.PURGE_MESSAGES.value, ignore_result=True)
 def purge_messages() -> int:
     return purge_expired_messages()
+
+
+@shared_task(name=Task.DELIVER_MESSAGE.value, ignore_result=True)
+def deliver_message(message_id: int) -> None:
+    """Offers a message a case sent to the other cases, once its sender's transaction committed."""
+    deliver_sent_message(message_id)

@@ -41,7 +41,7 @@ from hrc.cases.choices import (
 )
 from hrc.cases.drawing import ConstraintLine, NetDrawing, Node, draw_net
 from hrc.cases.forms import MappingForm, StartForm, StartRightsForm
-from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, WorkItem
+from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, Message, WorkItem
 from hrc.cases.nets import case_net
 from hrc.errors import Invalid, NotAllowed
 from hrc.organisations.choices import Role
@@ -145,7 +145,8 @@ class InterruptionRow:
 
 @login_required
 def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
-    """One case: its net with the marking, open tasks, incidents, interruptions and timeline."""
+    """One case: its net with the marking, open tasks, incidents, interruptions, the messages it
+    sent and took, and its timeline."""
     case = _supervised_case(request, pk)
     before = _seq_param(request, "before")
     drawing = _drawing(case.version.pk, case.version)
@@ -168,6 +169,7 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "work_rows": [work_row(item) for item in items],
         "incidents": incidents,
         "interruptions": _interruption_rows(selectors.interruptions_of(case)),
+        "case_messages": _message_rows(case, selectors.messages_of(case)),
         "events": events,
         "before": before,
         "older": older,
@@ -327,6 +329,38 @@ def _interruption_rows(interruptions: Iterable[Interruption]) -> list[Interrupti
         InterruptionRow(i, ((i.ended_at or now) - i.started_at).total_seconds(), i.ended_at is None)
         for i in interruptions
     ]
+
+
+@dataclass(frozen=True)
+class MessageRow:
+    message: Message
+    sent: bool  # by this case; else taken by it
+    from_: str  # who sent it: this case's transition, another case, or from outside
+    to: str  # who took it, or what became of it
+    correlation: str  # its keys, as JSON
+
+
+def _message_rows(case: Case, messages: Iterable[Message]) -> list[MessageRow]:
+    now = timezone.now()
+    rows = []
+    for message in messages:
+        source = message.sent_from_case
+        sender = (
+            _transition_of(message.sent_from_transition, source, case)
+            if source is not None
+            else "from outside"
+        )
+        if message.case is not None:
+            taker = _transition_of(message.transition, message.case, case)
+        else:
+            taker = "waiting" if message.expires_at > now else "expired, nobody took it"
+        keys = json.dumps(message.correlation, sort_keys=True)
+        rows.append(MessageRow(message, source == case, sender, taker, keys))
+    return rows
+
+
+def _transition_of(transition: str, of: Case, this: Case) -> str:
+    return transition if of == this else f"{transition} of case {of.pk}"
 
 
 def format_duration(seconds: float) -> str:

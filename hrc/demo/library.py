@@ -29,7 +29,8 @@ from hrc.patterns.selectors import latest_version
 from hrc.patterns.services import PublishRefused
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "patterns" / "examples"
-# The prototype's seven use cases, runnable with their data, beside the thesis' examples.
+# The prototype's seven use cases (and hrc's variant of the second), runnable with their data,
+# beside the thesis' examples.
 USE_CASES = "use_cases"
 
 

@@ -1,5 +1,6 @@
 """A small, safe expression language over case data: guards on transitions, task outputs
-mapped into case data, cobot step parameters taken from case data, message correlation.
+mapped into case data, cobot step parameters taken from case data, the messages a case
+sends and the correlation of those it waits for (these read `case` too, see taskconfig.py).
 
 Expressions use Python's expression syntax. They are parsed with `ast.parse(mode="eval")`
 and interpreted here over a whitelist of node types; no text is ever given to eval, exec

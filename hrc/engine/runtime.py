@@ -27,10 +27,12 @@ from hrc.engine.model import Pattern
 from hrc.engine.petri import Marking, NetTransition
 from hrc.engine.taskconfig import (
     MessageConfig,
+    SendConfig,
     TaskConfig,
     guard_of,
     initial_data,
     message_of,
+    send_of,
     task_config,
 )
 
@@ -56,6 +58,15 @@ class SpacePair:
     mode: str  # "pause" or "slow": how the cobot is interrupted
 
 
+@dataclass(frozen=True)
+class Outgoing:
+    """A message a transition sends, its expressions evaluated."""
+
+    name: str
+    correlation: dict[str, Any]
+    payload: dict[str, Any]
+
+
 class CaseNet:
     def __init__(self, pattern: Pattern) -> None:
         self.pattern = pattern
@@ -71,8 +82,12 @@ class CaseNet:
         self.labels: dict[str, str] = {}
         self.guards: dict[str, str] = {}
         self.messages: dict[str, MessageConfig] = {}
+        self.sends: dict[str, SendConfig] = {}
         for _, transition in pattern.transitions():
             self.labels[transition.id] = transition.label or transition.id
+            send = send_of(transition)
+            if send is not None:
+                self.sends[transition.id] = send
             if transition.performer is not None:
                 self.tasks[transition.id] = task_config(pattern, transition)
                 self.performers[transition.id] = transition.performer
@@ -258,13 +273,37 @@ def resolve(task: str, value: Any, data: Mapping[str, Any]) -> Any:
         raise RuntimeFault(f"The configuration of {task} failed: {problem}") from None
 
 
-def correlates(message: MessageConfig, data: Mapping[str, Any], keys: Mapping[str, Any]) -> bool:
-    """Whether a message with correlation `keys` is the one a case with `data` waits for."""
+def outgoing(
+    transition: str, send: SendConfig, data: Mapping[str, Any], case: Mapping[str, Any]
+) -> Outgoing:
+    """The message `transition` sends, over the case data and the case (id, reference).
+
+    Raises RuntimeFault when an expression fails."""
+    names = {"data": data, "case": case}
+    try:
+        correlation = expressions.resolve(dict(send.correlation), names)
+        payload = expressions.resolve(dict(send.payload), names)
+    except expressions.ExpressionError as problem:
+        raise RuntimeFault(
+            f"The message {send.name!r} that {transition} sends failed: {problem}"
+        ) from None
+    return Outgoing(send.name, correlation, payload)
+
+
+def correlates(
+    message: MessageConfig,
+    data: Mapping[str, Any],
+    keys: Mapping[str, Any],
+    case: Mapping[str, Any] | None = None,
+) -> bool:
+    """Whether a message with correlation `keys` is the one a case with `data` waits for;
+    `case` is the case's id and reference, for correlations that read them."""
     if set(keys) != set(message.correlation):
         return False
+    names = {"data": data, "case": dict(case or {})}
     for key, text in message.correlation.items():
         try:
-            if not _same_json_value(expressions.evaluate(text, {"data": data}), keys[key]):
+            if not _same_json_value(expressions.evaluate(text, names), keys[key]):
                 return False
         except expressions.ExpressionError:
             return False

@@ -19,7 +19,15 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
 - `"guard"` on a silent transition: an expression over `data`; a silent
   transition fires at once only when its guard holds.
 - `"message"` on a silent transition: `{"name": "...", "correlation": {"key": "expression"}}`;
-  it fires when a matching message arrives (POST /api/messages/), never by itself.
+  it fires when a matching message arrives (POST /api/messages/, or one a case
+  sent), never by itself.
+- `"send"` on a task (sent when it completes) or a silent transition (sent when
+  it fires): `{"name": "...", "correlation": {"key": value}, "payload": {"key": value}}`;
+  a message that correlates like one from outside, to another case or to
+  another process of the same case.
+
+Message correlation and send expressions read `case` (its `id` and
+`reference`) besides `data`: `=case.id` keeps a message inside its case.
 
 And the document itself may carry `"data"`: a JSON object every case's data
 starts with (the use case's settings: poses, spots, task lists); the data a
@@ -62,9 +70,11 @@ DEVICE_CALLS: Final[Mapping[str, tuple[str, tuple[str, ...], tuple[str, ...]]]] 
 # How a space constraint interrupts the cobot (its "interrupt" key); pause by default.
 INTERRUPT_MODES: Final = ("pause", "slow")
 
-# Names expressions may use: case data everywhere, a task's result in its outputs.
+# Names expressions may use: case data everywhere, a task's result in its outputs, the case
+# itself (id, reference) in what messages carry and match, so a case can address its own.
 DATA_NAMES: Final = frozenset({"data"})
 OUTPUT_NAMES: Final = frozenset({"data", "result"})
+MESSAGE_NAMES: Final = frozenset({"data", "case"})
 
 
 @dataclass(frozen=True)
@@ -234,9 +244,9 @@ def _device(t: str, raw: object) -> DeviceConfig:
     return DeviceConfig(call, args)
 
 
-def _check_value(t: str, what: str, value: object) -> None:
+def _check_value(t: str, what: str, value: object, names: frozenset[str] = DATA_NAMES) -> None:
     if expressions.is_expression(value):
-        _check_expression(t, what, str(value)[1:], DATA_NAMES)
+        _check_expression(t, what, str(value)[1:], names)
 
 
 def _check_expression(t: str, what: str, text: str, names: frozenset[str]) -> None:
@@ -249,6 +259,15 @@ def _check_expression(t: str, what: str, text: str, names: frozenset[str]) -> No
 class MessageConfig:
     name: str
     correlation: Mapping[str, str]
+
+
+@dataclass(frozen=True)
+class SendConfig:
+    """A message a transition sends: its values are literals or "=expressions" (MESSAGE_NAMES)."""
+
+    name: str
+    correlation: Mapping[str, Any]
+    payload: Mapping[str, Any]
 
 
 def guard_of(transition: Transition) -> str | None:
@@ -274,10 +293,46 @@ def message_of(transition: Transition) -> MessageConfig | None:
     if not isinstance(correlation, Mapping) or not all(
         isinstance(v, str) for v in correlation.values()
     ):
-        raise ConfigError(t, "the message's 'correlation' maps keys to expressions over data.")
+        raise ConfigError(
+            t, "the message's 'correlation' maps keys to expressions over data and case."
+        )
     for key, text in correlation.items():
-        _check_expression(t, f"correlation {key!r}", text, DATA_NAMES)
+        _check_expression(t, f"correlation {key!r}", text, MESSAGE_NAMES)
     return MessageConfig(raw["name"], correlation)
+
+
+def send_of(transition: Transition) -> SendConfig | None:
+    """What message a transition sends when it completes or fires, None when it sends none."""
+    raw = transition.extra.get("send")
+    if raw is None:
+        return None
+    t = transition.id
+    if not isinstance(raw, Mapping):
+        raise ConfigError(t, "'send' must be an object with a 'name'.")
+    unknown = sorted(set(raw) - {"name", "correlation", "payload"})
+    if unknown:
+        raise ConfigError(t, f"'send' has no key {unknown[0]!r} (name, correlation, payload).")
+    if not isinstance(raw.get("name"), str) or not raw["name"].strip():
+        raise ConfigError(t, "'send' needs a 'name': the message's name.")
+    parts = {key: raw.get(key, {}) for key in ("correlation", "payload")}
+    for key, values in parts.items():
+        if not isinstance(values, Mapping):
+            raise ConfigError(t, f"the 'send' {key!r} must map keys to values or expressions.")
+        for name, value in values.items():
+            _check_nested(t, f"send {key} {name!r}", value)
+    return SendConfig(raw["name"], parts["correlation"], parts["payload"])
+
+
+def _check_nested(t: str, what: str, value: object) -> None:
+    """A send value's expressions, also inside lists and objects, as resolve() will find them."""
+    if isinstance(value, list):
+        for item in value:
+            _check_nested(t, what, item)
+    elif isinstance(value, Mapping):
+        for item in value.values():
+            _check_nested(t, what, item)
+    else:
+        _check_value(t, what, value, MESSAGE_NAMES)
 
 
 def initial_data(pattern: Pattern) -> dict[str, Any]:
@@ -306,9 +361,11 @@ def config_issues(pattern: Pattern) -> list[Issue]:
                     if key in transition.extra:
                         raise ConfigError(transition.id, f"only silent transitions have a '{key}'.")
                 task_config(pattern, transition)
+                send_of(transition)
             else:
                 if "task" in transition.extra:
                     raise ConfigError(transition.id, "a silent transition runs no 'task'.")
+                send_of(transition)
                 if guard_of(transition) is not None and message_of(transition) is not None:
                     raise ConfigError(
                         transition.id,

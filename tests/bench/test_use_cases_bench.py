@@ -29,7 +29,10 @@ def test_quick_sets_the_small_sizes_and_explicit_options_win() -> None:
         "5_polishing",
     ]
     assert parse_args([]) == Settings()
-    assert len(use_case_files()) == 9  # the seven and two of hrc's variants
+    assert len(use_case_files()) == 10  # the seven and three of hrc's variants
+    assert [path.stem for path in use_case_files(("2b",))] == [
+        "2b_extended_spot_taping_queue_variant"
+    ]
 
 
 @pytest.mark.parametrize(
@@ -42,7 +45,7 @@ def test_nonsense_options_are_refused(arguments: list[str]) -> None:
 
 
 def test_a_quick_run_writes_the_report_and_leaves_nothing_behind(tmp_path: Path) -> None:
-    command = [sys.executable, "-m", "bench.use_cases", "--quick", "--only", "2,6",
+    command = [sys.executable, "-m", "bench.use_cases", "--quick", "--only", "2b,6",
                "--results-dir", str(tmp_path)]  # fmt: skip
     child = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     output, _ = child.communicate(timeout=900)
@@ -51,8 +54,9 @@ def test_a_quick_run_writes_the_report_and_leaves_nothing_behind(tmp_path: Path)
     report = json.loads((tmp_path / "use-cases-latest.json").read_text())
     assert report["settings"]["time_scale"] == QUICK["time_scale"]
     rows = {row["file"]: row for row in report["use_cases"]}
-    assert set(rows) == {"2_extended_spot_taping.json", "6_fixture.json"}
-    assert rows["2_extended_spot_taping.json"]["cases_per_round"] == 2  # both operators at once
+    queue_variant = "2b_extended_spot_taping_queue_variant.json"
+    assert set(rows) == {queue_variant, "6_fixture.json"}
+    assert rows[queue_variant]["cases_per_round"] == 2  # both operators' cases at once
     for row in rows.values():
         summary = row["summary"]
         assert summary["completed"] == summary["cases"] == len(row["cases"]) >= 1

@@ -25,6 +25,8 @@ EVENTS = {
     "task-resumed",
     "case-completed",
     "case-failed",
+    "message-sent",
+    "message-received",
 }
 
 Event = dict[str, Any]

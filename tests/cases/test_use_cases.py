@@ -20,8 +20,8 @@ from typing import Any
 
 import pytest
 
-from hrc.cases.choices import CaseStatus, JobState, WorkItemKind
-from hrc.cases.models import Case, Incident, Interruption, Job
+from hrc.cases.choices import CaseStatus, EventType, JobState, WorkItemKind
+from hrc.cases.models import Case, Incident, Interruption, Job, Message
 from hrc.cases.simulation import Simulation
 from hrc.engine import check_document, read_pattern
 from tests.cases.test_run_pattern import check_trace
@@ -115,6 +115,7 @@ def test_every_use_case_is_published_sound_with_its_declared_pattern() -> None:
     assert stems == [
         "1_spot_taping",
         "2_extended_spot_taping",
+        "2b_extended_spot_taping_queue_variant",
         "3_pick_and_place",
         "4_quality_inspection",
         "4b_quality_inspection_rechecks_while_homing_variant",
@@ -128,14 +129,18 @@ def test_every_use_case_is_published_sound_with_its_declared_pattern() -> None:
         report = check_document(document)
         assert report.valid, (stem, [issue.message for issue in report.errors])
         assert report.sound is True
-        assert document["declared_pattern"] in report.patterns
-        if stem == "4_quality_inspection":
+        if stem == "2_extended_spot_taping":
+            # Two processes sharing the cobots: each is synchronized, the whole none of the four.
+            assert "declared_pattern" not in document
+            assert [issue.code for issue in report.warnings] == ["no-pattern"]
+        elif stem == "4_quality_inspection":
             # The thesis' own: its inspectors never share an area, so it has no constraints and
             # counts as cooperation only for that reason, which the check says.
+            assert document["declared_pattern"] in report.patterns
             assert [w.code for w in report.warnings] == ["vacuous-pattern"], report.warnings
-            continue
-        assert list(report.patterns) == [document["declared_pattern"]]
-        assert report.warnings == ()
+        else:
+            assert list(report.patterns) == [document["declared_pattern"]]
+            assert report.warnings == ()
         if "variant" in stem:
             assert "hrc's variant" in document["name"], stem
 
@@ -161,10 +166,40 @@ def test_spot_taping_tapes_four_harnesses_in_two_cycles_the_pedal_moving_the_axi
 
 
 @pytest.mark.django_db(transaction=True)
-def test_extended_spot_taping_shares_the_cobots_between_two_operators_one_step_at_a_time(
+def test_extended_spot_taping_two_processes_take_turns_on_the_cobots_told_by_messages(
     tmp_path: Path, start_worker: Callable[..., WorkerProcess]
 ) -> None:
-    run = run_use_case("2_extended_spot_taping", tmp_path, start_worker, cases=2, workers=2)
+    run = run_use_case("2_extended_spot_taping", tmp_path, start_worker, workers=2)
+
+    [case] = run.cases
+    assert (case.data["cycle_1"], case.data["harnesses_1"]) == (2, 4)
+    assert (case.data["cycle_2"], case.data["harnesses_2"]) == (2, 4)
+    assert run.executions == {"c1": 8, "c2": 8}  # four spots for each operator on each cobot
+    # Every message the processes sent each other, the case itself took, and only it.
+    messages = Message.objects.filter(sent_from_case=case)
+    assert messages.count() == 16  # 2 cycles × (3 + 3 syncs, last_cycle), and 2 between them
+    assert set(messages.values_list("case", flat=True)) == {case.pk}
+    assert not messages.filter(consumed_at__isnull=True).exists()
+    sent = case.events.filter(type=EventType.MESSAGE_SENT)
+    assert {event.detail["message"] for event in sent} == set(
+        messages.values_list("message_id", flat=True)
+    )
+    assert {event.detail["correlation"]["case"] for event in sent} == {case.pk}
+    # Each step job ran after the one before it on its cobot had ended.
+    for cobot, jobs in _cobot_jobs(run.cases):
+        for before, after in itertools.pairwise(jobs):
+            assert before.ended_at is not None
+            assert after.started_at is not None
+            assert before.ended_at <= after.started_at, f"cobot {cobot}: {before.pk}, {after.pk}"
+
+
+@pytest.mark.django_db(transaction=True)
+def test_extended_spot_taping_queue_variant_shares_the_cobots_between_two_cases(
+    tmp_path: Path, start_worker: Callable[..., WorkerProcess]
+) -> None:
+    run = run_use_case(
+        "2b_extended_spot_taping_queue_variant", tmp_path, start_worker, cases=2, workers=2
+    )
 
     first, second = run.cases
     assert first.data["workspace"] == 0

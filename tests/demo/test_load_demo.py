@@ -110,7 +110,7 @@ def test_every_example_can_start_a_case_with_the_demo_people_and_cobots() -> Non
 @pytest.mark.django_db
 def test_every_shipped_example_is_published_as_version_1() -> None:
     examples = example_files(EXAMPLES_DIR)
-    assert len(examples) == 8 + 7, "the thesis' examples and the prototype's use cases"
+    assert len(examples) == 8 + 7 + 3, "the thesis' examples, the prototype's use cases, 2b, 4b, 5b"
     _load_demo("--strict")
     names = {json.loads(path.read_text())["name"] for path in examples}
     patterns = PatternModel.objects.filter(organisation__slug="demo-plant")

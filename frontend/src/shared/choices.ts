@@ -34,6 +34,7 @@ export const EVENT_TYPES: Record<string, string> = {
   "task-interrupted": "Task interrupted",
   "task-resumed": "Task resumed",
   "transition-fired": "Transition fired",
+  "message-sent": "Message sent",
   "message-received": "Message received",
   "step-retry": "Step will be retried",
   "step-failed": "Step failed",
