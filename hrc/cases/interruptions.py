@@ -1,5 +1,9 @@
 """A space constraint's interruption, on the cobot: pause (or slow) it, and resume it after.
 
+A wait or a refusal (a task kept out of the area) commands nothing; only pauses
+and slowdowns go to the cobot. A step that starts beside an operator under
+"slow" is slowed by its own worker before it is sent (`slow_down_before_step`).
+
 The rows (who interrupted whom, when it ended) are written by the case
 services; these commands follow on the workers. Each command is claimed in a
 committed conditional update (Interruption.claimed_at), sent outside any
@@ -18,7 +22,7 @@ from django.db.models import Q, QuerySet
 from django.utils import timezone
 
 from hrc.cases import dispatch
-from hrc.cases.choices import JobState
+from hrc.cases.choices import COMMANDED_MODES, InterruptionMode, JobState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
 from hrc.cobots.commands import outside_transaction
@@ -57,7 +61,7 @@ def resume_cobot(interruption_id: int) -> None:
     if claimed is None:
         return
     others = Interruption.objects.filter(
-        cobot=claimed.cobot, ended_at__isnull=True, paused_at__isnull=False
+        cobot=claimed.cobot, mode=claimed.mode, ended_at__isnull=True, paused_at__isnull=False
     ).exclude(pk=claimed.pk)
     needed = claimed.paused_at is not None and not others.exists()
     needed = needed and claimed.cobot.stopped_at is None  # a STOP's resume restarts it
@@ -70,13 +74,26 @@ def resume_cobot(interruption_id: int) -> None:
         ring_next_job_on_commit(claimed.cobot_id)  # the queue waited for this to settle
 
 
+def slow_down_before_step(cobot_id: int) -> bool:
+    """Sends the slowdowns of the cobot's steps that start beside an operator (mode slow, not
+    yet sent) before the step goes; whether none is left unsent."""
+    pending = Interruption.objects.filter(
+        cobot_id=cobot_id, mode=InterruptionMode.SLOW, ended_at__isnull=True, paused_at__isnull=True
+    )
+    for interruption_id in pending.values_list("pk", flat=True):
+        interrupt_cobot(interruption_id)
+    return not pending.exists()
+
+
 def _claim(interruption_id: int, due: Q) -> Interruption | None:
     """The interruption, once this sender alone may command its cobot for it; None when it is
     not `due`, or another sender holds it."""
     now = timezone.now()
     free = Q(claimed_at__isnull=True) | Q(claimed_at__lt=now - CLAIM_EXPIRES)
     with transaction.atomic():
-        won = Interruption.objects.filter(due, free, pk=interruption_id).update(claimed_at=now)
+        won = Interruption.objects.filter(
+            due, free, pk=interruption_id, mode__in=COMMANDED_MODES
+        ).update(claimed_at=now)
     if not won:
         return None
     return Interruption.objects.select_related("cobot").get(pk=interruption_id)
@@ -117,8 +134,8 @@ def ring_next_job_on_commit(cobot_id: int) -> None:
 
 
 def holding(cobot_id: int) -> QuerySet[Interruption]:
-    """The interruptions that keep the cobot paused or slowed."""
-    return Interruption.objects.filter(cobot_id=cobot_id).filter(
+    """The pauses that keep the cobot paused (a slowed cobot may run)."""
+    return Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.PAUSE).filter(
         Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
 
@@ -130,10 +147,9 @@ def holds_cobot(cobot_id: int) -> bool:
 
 def to_redo() -> list[tuple[Task, int]]:
     """Pauses that failed while the interruption is open, resumes not yet done after it ended."""
-    pauses = Interruption.objects.filter(ended_at__isnull=True, paused_at__isnull=True).exclude(
-        error=""
-    )
-    resumes = Interruption.objects.filter(ended_at__isnull=False, resumed_at__isnull=True)
+    commanded = Interruption.objects.filter(mode__in=COMMANDED_MODES)
+    pauses = commanded.filter(ended_at__isnull=True, paused_at__isnull=True).exclude(error="")
+    resumes = commanded.filter(ended_at__isnull=False, resumed_at__isnull=True)
     return [(Task.INTERRUPT_COBOT, pk) for pk in pauses.values_list("pk", flat=True)] + [
         (Task.RESUME_COBOT, pk) for pk in resumes.values_list("pk", flat=True)
     ]

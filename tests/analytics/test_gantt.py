@@ -131,15 +131,19 @@ def test_a_target_that_never_started_or_has_no_source_bar_gets_no_arrow() -> Non
 
 def test_interruptions_become_marks_in_time_order() -> None:
     interruptions = [
-        InterruptionRow(8, 1, 2, 3, 1, "ur5e-left", "slow", at(60), None, None, None),
-        InterruptionRow(7, 1, 2, 3, 1, "ur5e-left", "pause", at(50), at(55), at(50), at(55)),
+        InterruptionRow(
+            8, 1, 2, "c", 3, "to1", "", "o", 1, "ur5e-left", "slow", at(60), None, None, None
+        ),
+        InterruptionRow(
+            7, 1, 2, "c", 3, "to1", "", "o", 1, "ur5e-left", "pause", at(50), at(55), at(50), at(55)
+        ),
     ]
     gantt = build_gantt(
         1, started_at=at(0), ended_at=None, now=at(120), actors=ACTORS,
         items=[item(2, "tc1", "c", 30, 40, None, "running"), item(3, "to2", "o", 45, 50, None, "running")],
         constraints=[], interruptions=interruptions,
     )  # fmt: skip
-    assert [(m.interruption, m.mode, m.work_item, m.operator_work_item) for m in gantt.marks] == [
+    assert [(m.interruption, m.mode, m.work_item, m.by_work_item) for m in gantt.marks] == [
         (7, "pause", 2, 3),
         (8, "slow", 2, 3),
     ]
@@ -149,7 +153,9 @@ def test_interruptions_become_marks_in_time_order() -> None:
 
 
 def test_the_drawing_maps_time_to_x_between_the_labels_and_the_right_margin() -> None:
-    interruption = InterruptionRow(7, 1, 2, 1, 1, "ur5e-left", "pause", at(50), at(60), None, None)
+    interruption = InterruptionRow(
+        7, 1, 2, "c", 1, "to1", "", "o", 1, "ur5e-left", "pause", at(50), at(60), None, None
+    )
     gantt = build_gantt(
         1, started_at=at(0), ended_at=at(100), now=at(120), actors=ACTORS,
         items=[item(1, "to1", "o", 0, 10, 30), item(2, "tc1", "c", 30, 40, 90),
