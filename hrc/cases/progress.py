@@ -439,14 +439,15 @@ def _end_interruptions(case: Case, which: Q) -> None:
     for interruption in Interruption.objects.filter(which, case=case, ended_at__isnull=True):
         interruption.ended_at = timezone.now()
         interruption.save(update_fields=["ended_at"])
+        if interruption.mode not in COMMANDED_MODES:
+            # Kept out: the task may start now (its start is its event); a waiting step goes.
+            if interruption.mode == InterruptionMode.WAIT:
+                _ring_for_waiting_step(interruption.work_item_id)
+            continue
         seconds = (interruption.ended_at - interruption.started_at).total_seconds()
         record_event(case, EventType.TASK_RESUMED, item=interruption.work_item,
-                detail={"interruption": interruption.pk, "seconds": round(seconds, 3),
-                        "mode": interruption.mode})  # fmt: skip
-        if interruption.mode in COMMANDED_MODES:
-            dispatch.send_on_commit(Task.RESUME_COBOT, interruption.pk)
-        elif interruption.mode == InterruptionMode.WAIT:
-            _ring_for_waiting_step(interruption.work_item_id)
+                detail={"interruption": interruption.pk, "seconds": round(seconds, 3)})  # fmt: skip
+        dispatch.send_on_commit(Task.RESUME_COBOT, interruption.pk)
 
 
 def _ring_for_waiting_step(item_id: int) -> None:
