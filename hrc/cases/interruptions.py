@@ -28,6 +28,7 @@ from hrc.cases.models import Interruption, Job
 from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
+from hrc.cobots.models import Cobot
 from hrc_gateway import urua
 
 SLOW_OVERRIDE_PERCENT = 10.0
@@ -38,10 +39,11 @@ CLAIM_EXPIRES: Final = dt.timedelta(minutes=2)
 
 def interrupt_cobot(interruption_id: int) -> None:
     """Pauses (or slows) the cobot for an interruption still open; never twice."""
-    claimed = _claim(interruption_id, Q(ended_at__isnull=True, paused_at__isnull=True))
-    if claimed is None:
+    won = _claim(interruption_id, Q(ended_at__isnull=True, paused_at__isnull=True))
+    if won is None:
         return
-    error = _command(claimed, pause=True)
+    claimed, cobot = won
+    error = _command(claimed, cobot, pause=True)
     with transaction.atomic():
         if error:
             _record(claimed, error=f"pause: {error}")
@@ -57,21 +59,22 @@ def resume_cobot(interruption_id: int) -> None:
 
     A resume that fails is left for the sweeper, which sends it again until it succeeds.
     """
-    claimed = _claim(interruption_id, Q(ended_at__isnull=False, resumed_at__isnull=True))
-    if claimed is None:
+    won = _claim(interruption_id, Q(ended_at__isnull=False, resumed_at__isnull=True))
+    if won is None:
         return
+    claimed, cobot = won
     others = Interruption.objects.filter(
-        cobot=claimed.cobot, mode=claimed.mode, ended_at__isnull=True, paused_at__isnull=False
+        cobot=cobot, mode=claimed.mode, ended_at__isnull=True, paused_at__isnull=False
     ).exclude(pk=claimed.pk)
     needed = claimed.paused_at is not None and not others.exists()
-    needed = needed and claimed.cobot.stopped_at is None  # a STOP's resume restarts it
-    error = _command(claimed, pause=False) if needed else ""
+    needed = needed and cobot.stopped_at is None  # a STOP's resume restarts it
+    error = _command(claimed, cobot, pause=False) if needed else ""
     with transaction.atomic():
         if error:
             _record(claimed, error=f"resume: {error}")
             return
         _record(claimed, resumed_at=timezone.now())
-        ring_next_job_on_commit(claimed.cobot_id)  # the queue waited for this to settle
+        ring_next_job_on_commit(cobot.pk)  # the queue waited for this to settle
 
 
 def slow_down_before_step(cobot_id: int) -> bool:
@@ -85,9 +88,9 @@ def slow_down_before_step(cobot_id: int) -> bool:
     return not pending.exists()
 
 
-def _claim(interruption_id: int, due: Q) -> Interruption | None:
-    """The interruption, once this sender alone may command its cobot for it; None when it is
-    not `due`, or another sender holds it."""
+def _claim(interruption_id: int, due: Q) -> tuple[Interruption, Cobot] | None:
+    """The interruption and its cobot, once this sender alone may command the cobot for it;
+    None when it is not `due` (nor a pause or a slowdown), or another sender holds it."""
     now = timezone.now()
     free = Q(claimed_at__isnull=True) | Q(claimed_at__lt=now - CLAIM_EXPIRES)
     with transaction.atomic():
@@ -96,7 +99,9 @@ def _claim(interruption_id: int, due: Q) -> Interruption | None:
         ).update(claimed_at=now)
     if not won:
         return None
-    return Interruption.objects.select_related("cobot").get(pk=interruption_id)
+    claimed = Interruption.objects.select_related("cobot").get(pk=interruption_id)
+    assert claimed.cobot is not None  # a pause or a slowdown holds a cobot's step
+    return claimed, claimed.cobot
 
 
 def _record(interruption: Interruption, **outcome: object) -> None:
@@ -104,11 +109,11 @@ def _record(interruption: Interruption, **outcome: object) -> None:
     Interruption.objects.filter(pk=interruption.pk).update(claimed_at=None, **outcome)
 
 
-def _command(interruption: Interruption, *, pause: bool) -> str:
+def _command(interruption: Interruption, cobot: Cobot, *, pause: bool) -> str:
     """Pauses or resumes (slows or restores the speed of) the cobot; "" when done, else why not."""
 
     def send() -> None:
-        driver = driver_for_cobot(interruption.cobot)
+        driver = driver_for_cobot(cobot)
         if interruption.mode == "slow":
             speed = SLOW_OVERRIDE_PERCENT if pause else FULL_OVERRIDE_PERCENT
             driver.write({urua.STATE_OVERRIDE: speed})

@@ -149,6 +149,63 @@ def test_interruptions_become_marks_in_time_order() -> None:
     ]
 
 
+def test_every_kind_of_interruption_is_marked_on_the_held_tasks_bar_naming_the_other() -> None:
+    actors = [*ACTORS, ActorRow("p", "operator", "paul")]
+    interruptions = [
+        # Paul refused while Olivia's to1 was in the area, then the cobot's step waiting for it.
+        InterruptionRow(
+            1,
+            1,
+            3,
+            "p",
+            1,
+            "to1",
+            "to1 label",
+            "o",
+            None,
+            None,
+            "refused",
+            at(12),
+            at(30),
+            None,
+            None,
+        ),
+        InterruptionRow(
+            2,
+            1,
+            2,
+            "c",
+            1,
+            "to1",
+            "to1 label",
+            "o",
+            1,
+            "ur5e-left",
+            "wait",
+            at(15),
+            at(30),
+            None,
+            None,
+        ),
+    ]
+    gantt = build_gantt(
+        1, started_at=at(0), ended_at=at(60), now=at(60), actors=actors,
+        items=[item(1, "to1", "o", 0, 10, 30), item(2, "tc1", "c", 15, 30, 50),
+               item(3, "to2", "p", 11, 30, 40)],
+        constraints=[], interruptions=interruptions,
+    )  # fmt: skip
+
+    drawing = draw_gantt(gantt, width=1024 + LABEL_WIDTH + RIGHT_MARGIN)
+
+    bars = {b.bar.work_item: b for b in drawing.bars}
+    refused, waited = drawing.marks
+    assert (refused.y, waited.y) == (bars[3].y, bars[2].y)  # on the held task's row
+    assert refused.x < waited.x < bars[2].x  # from when it was kept out until it could start
+    assert (refused.word, waited.word) == ("refused", "waited")
+    assert refused.title == "p refused: to1 label (o) in the shared area"
+    assert waited.title == "c (ur5e-left) waited: to1 label (o) in the shared area"
+
+
 # Drawing -----------------------------------------------------------------------------------
 
 
