@@ -182,6 +182,8 @@ def test_two_cobots_sharing_an_area_never_run_their_steps_at_once(
     assert "is in the shared area" in waiting.waiting_for
     held = Interruption.objects.filter(case_id__in=cases, mode=InterruptionMode.WAIT)
     assert held.count() >= 1
+    # One interruption per waiting step, however often its doorbell rang meanwhile.
+    assert len({i.work_item_id for i in held}) == held.count()
     for interruption in held:
         assert interruption.ended_at is not None
         occupant = interruption.by_work_item
