@@ -29,7 +29,7 @@ def test_quick_sets_the_small_sizes_and_explicit_options_win() -> None:
         "5_polishing",
     ]
     assert parse_args([]) == Settings()
-    assert len(use_case_files()) == 7
+    assert len(use_case_files()) == 9  # the seven and two of hrc's variants
 
 
 @pytest.mark.parametrize(

@@ -165,9 +165,11 @@ def _claim_and_start(page: Page, case: int, label: str) -> Any:
     item = offered.get_attribute("data-item")
     offered.get_by_role("button", name="Claim").click()
     card = page.locator(f'.cards.mine .card[data-item="{item}"]')
-    expect(card).to_have_attribute("data-state", "claimed")
+    # Each press is a write to the demo's database, which its workers share: on the embedded
+    # SQLite under a loaded machine a write may queue behind theirs for seconds.
+    expect(card).to_have_attribute("data-state", "claimed", timeout=LIVE_MS)
     card.get_by_role("button", name="Start").click()
-    expect(card).to_have_attribute("data-state", "running")
+    expect(card).to_have_attribute("data-state", "running", timeout=LIVE_MS)
     return card
 
 
