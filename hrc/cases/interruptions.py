@@ -1,8 +1,9 @@
 """A space constraint's interruption, on the cobot: pause (or slow) it, and resume it after.
 
 A wait or a refusal (a task kept out of the area) commands nothing; only pauses
-and slowdowns go to the cobot. A step that starts beside an operator under
-"slow" is slowed by its own worker before it is sent (`slow_down_before_step`).
+and slowdowns go to the cobot. The speed a step runs at is set by its own worker
+before the step is sent (`set_speed_before_step`): slowed when it starts beside
+an operator under "slow", full speed when a slowdown has ended meanwhile.
 
 The rows (who interrupted whom, when it ended) are written by the case
 services; these commands follow on the workers. Each command is claimed in a
@@ -77,15 +78,18 @@ def resume_cobot(interruption_id: int) -> None:
         ring_next_job_on_commit(cobot.pk)  # the queue waited for this to settle
 
 
-def slow_down_before_step(cobot_id: int) -> bool:
-    """Sends the slowdowns of the cobot's steps that start beside an operator (mode slow, not
-    yet sent) before the step goes; whether none is left unsent."""
-    pending = Interruption.objects.filter(
-        cobot_id=cobot_id, mode=InterruptionMode.SLOW, ended_at__isnull=True, paused_at__isnull=True
-    )
+def set_speed_before_step(cobot_id: int) -> bool:
+    """Gives the cobot the speed its next step runs at, before the step goes: full speed
+    restored after the slowdowns that ended, then slowed for those still open (a step that
+    starts beside an operator); whether none is left unsent (another sender may hold one)."""
+    slowdowns = Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.SLOW)
+    restores = slowdowns.filter(ended_at__isnull=False, resumed_at__isnull=True)
+    for interruption_id in restores.values_list("pk", flat=True):
+        resume_cobot(interruption_id)
+    pending = slowdowns.filter(ended_at__isnull=True, paused_at__isnull=True)
     for interruption_id in pending.values_list("pk", flat=True):
         interrupt_cobot(interruption_id)
-    return not pending.exists()
+    return not restores.exists() and not pending.exists()
 
 
 def _claim(interruption_id: int, due: Q) -> tuple[Interruption, Cobot] | None:

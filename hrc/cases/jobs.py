@@ -243,12 +243,10 @@ def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
 
 
 def _unsettled_interruptions(cobot: Cobot | int) -> QuerySet[Interruption]:
-    """The interruptions that keep the cobot (or the cobot of that id) from taking a step: a
-    pause not yet over and resumed, or a slowdown over whose full speed is not yet restored."""
-    undone = Q(paused_at__isnull=False, resumed_at__isnull=True)
-    return Interruption.objects.filter(cobot=cobot).filter(
-        Q(undone | Q(ended_at__isnull=True), mode=InterruptionMode.PAUSE)
-        | Q(undone, mode=InterruptionMode.SLOW, ended_at__isnull=False)
+    """The pauses that keep the cobot (or the cobot of that id) from taking a step: not yet
+    over, or not yet resumed. A slowed cobot takes steps (its worker sets their speed)."""
+    return Interruption.objects.filter(cobot=cobot, mode=InterruptionMode.PAUSE).filter(
+        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
 
 
@@ -260,9 +258,9 @@ def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
         on_sent()  # a call (an inspection, say) may take a while: tablets need not wait for it
         return _call_device(driver, lease)
     _prepare(driver, lease.cobot.pk, command["program"], lease.timeout)
-    if not interruptions.slow_down_before_step(lease.cobot.pk):
+    if not interruptions.set_speed_before_step(lease.cobot.pk):
         raise CobotPaused(
-            f"{driver.name} could not be slowed down for the operator in its shared area; "
+            f"{driver.name}'s speed for an operator in its shared area is not set yet; "
             "the step waits until it is."
         )
     step = StepCommand(
