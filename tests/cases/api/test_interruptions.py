@@ -43,6 +43,7 @@ def test_a_member_reads_the_interruptions_in_order_with_their_durations(
     assert [row["id"] for row in rows] == [i.pk for i in interruptions]
     over, ongoing = rows
     assert (over["task"], over["by_task"], over["cobot_name"]) == ("tc1", "to1", cobot.name)
+    assert (over["actor"], over["by_actor"]) == ("c", "o")  # both pattern actors
     assert (over["mode"], over["seconds"], over["settled"]) == ("pause", 12.5, True)
     assert (ongoing["mode"], ongoing["seconds"], ongoing["settled"]) == ("slow", None, False)
 
