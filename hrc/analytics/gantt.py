@@ -1,5 +1,5 @@
 """A case as a Gantt chart: the actors as rows, each work item a bar, each constraint arrows
-between the bars of its two tasks, interruptions marked on the cobot's bar.
+between the bars of its two tasks, interruptions marked on the held task's bar.
 
 Pure functions over hrc.analytics.metrics' rows. `build_gantt` says what is in
 the chart (the API's answer); `draw_gantt` places it on a canvas for the
@@ -25,6 +25,7 @@ import statistics
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from typing import Final
 
 from hrc.analytics.metrics import InterruptionRow, ItemRow, seconds
 
@@ -99,12 +100,17 @@ class Arrow:
 
 @dataclass(frozen=True)
 class Mark:
-    """An interruption of a cobot's task while an operator worked in the shared space."""
+    """A task held while another was in the shared area: a cobot's step paused or slowed,
+    or a task kept out (a step waiting, an operator refused), marked on the held task's bar."""
 
     interruption: int
     work_item: int
-    operator_work_item: int
-    cobot: str
+    actor: str
+    by_work_item: int
+    by_task: str
+    by_label: str
+    by_actor: str
+    cobot: str | None
     mode: str
     started_at: dt.datetime
     ended_at: dt.datetime | None
@@ -230,7 +236,8 @@ def _arrow(
 
 def _mark(row: InterruptionRow) -> Mark:
     return Mark(
-        row.id, row.work_item_id, row.operator_work_item_id, row.cobot, row.mode,
+        row.id, row.work_item_id, row.actor, row.by_work_item_id, row.by_task,
+        row.by_label or row.by_task, row.by_actor, row.cobot, row.mode,
         row.started_at, row.ended_at, row.paused_at, row.resumed_at,
     )  # fmt: skip
 
@@ -382,6 +389,10 @@ class DrawnArrow:
     path: str
 
 
+# What each interruption mode did to the held task, as a mark's words say it.
+MARK_WORDS: Final = {"pause": "paused", "slow": "slowed", "wait": "waited", "refused": "refused"}
+
+
 @dataclass(frozen=True)
 class DrawnMark:
     mark: Mark
@@ -389,6 +400,18 @@ class DrawnMark:
     y: float
     width: float
     ongoing: bool
+
+    @property
+    def word(self) -> str:
+        return MARK_WORDS.get(self.mark.mode, self.mark.mode)
+
+    @property
+    def title(self) -> str:
+        """What held the task: the other task and its actor, in the shared area."""
+        mark = self.mark
+        held = f"{mark.actor} ({mark.cobot})" if mark.cobot else mark.actor
+        ongoing = ", ongoing" if self.ongoing else ""
+        return f"{held} {self.word}: {mark.by_label} ({mark.by_actor}) in the shared area{ongoing}"
 
     @property
     def icon_y(self) -> float:

@@ -79,12 +79,18 @@ def job_busy_interval(job: JobRow, now: dt.datetime) -> Interval | None:
 
 @dataclass(frozen=True)
 class InterruptionRow:
+    """A task held (`work_item`, its `actor`) while another (`by_…`) was in the shared area."""
+
     id: int
     case_id: int
     work_item_id: int
-    operator_work_item_id: int
-    cobot_id: int
-    cobot: str
+    actor: str
+    by_work_item_id: int
+    by_task: str
+    by_label: str
+    by_actor: str
+    cobot_id: int | None
+    cobot: str | None  # None: an operator was refused
     mode: str
     started_at: dt.datetime
     ended_at: dt.datetime | None
@@ -322,7 +328,8 @@ def interruption_figures(interruptions: Iterable[InterruptionRow]) -> Interrupti
     by_cobot: dict[str, int] = defaultdict(int)
     for row in rows:
         by_mode[row.mode] += 1
-        by_cobot[row.cobot] += 1
+        if row.cobot is not None:
+            by_cobot[row.cobot] += 1
     return InterruptionFigures(
         count=len(rows),
         ongoing=sum(1 for row in rows if row.ended_at is None),

@@ -168,7 +168,8 @@ def job_rows(cases: QuerySet[Case]) -> list[JobRow]:
 
 def interruption_rows(cases: QuerySet[Case]) -> list[InterruptionRow]:
     fields = (
-        "pk", "case_id", "work_item_id", "operator_work_item_id", "cobot_id", "cobot__name",
+        "pk", "case_id", "work_item_id", "work_item__actor", "by_work_item_id",
+        "by_work_item__task", "by_work_item__label", "by_work_item__actor", "cobot_id", "cobot__name",
         "mode", "started_at", "ended_at", "paused_at", "resumed_at",
     )  # fmt: skip
     interruptions = Interruption.objects.filter(case__in=cases).order_by("started_at", "pk")

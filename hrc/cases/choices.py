@@ -71,6 +71,13 @@ class InterruptionMode(models.TextChoices):
     PAUSE = "pause", "Pause"
     # The speed override is lowered instead of pausing (where the cobot supports it).
     SLOW = "slow", "Slow down"
+    # Kept out until the task in the area completes: a cobot's step waits, an operator is refused.
+    WAIT = "wait", "Wait for the area"
+    REFUSED = "refused", "Refused"
+
+
+# The modes that command the cobot (and undo it after); a wait or a refusal only ends.
+COMMANDED_MODES = (InterruptionMode.PAUSE, InterruptionMode.SLOW)
 
 
 class EventType(models.TextChoices):
@@ -90,6 +97,8 @@ class EventType(models.TextChoices):
     TASK_WITHDRAWN = "task-withdrawn", "Task withdrawn"
     TASK_INTERRUPTED = "task-interrupted", "Task interrupted"
     TASK_RESUMED = "task-resumed", "Task resumed"
+    # Refused (an operator) or held back (a cobot's step) while another task is in its shared area.
+    TASK_KEPT_OUT = "task-kept-out", "Task kept out of a shared area"
     # A silent (routing) transition fired.
     TRANSITION_FIRED = "transition-fired", "Transition fired"
     # The case sent a message as a task completed or a transition fired (a "send" key).

@@ -1,5 +1,10 @@
 """A space constraint's interruption, on the cobot: pause (or slow) it, and resume it after.
 
+A wait or a refusal (a task kept out of the area) commands nothing; only pauses
+and slowdowns go to the cobot. The speed a step runs at is set by its own worker
+before the step is sent (`set_speed_before_step`): slowed when it starts beside
+an operator under "slow", full speed when a slowdown has ended meanwhile.
+
 The rows (who interrupted whom, when it ended) are written by the case
 services; these commands follow on the workers. Each command is claimed in a
 committed conditional update (Interruption.claimed_at), sent outside any
@@ -18,12 +23,13 @@ from django.db.models import Q, QuerySet
 from django.utils import timezone
 
 from hrc.cases import dispatch
-from hrc.cases.choices import JobState
+from hrc.cases.choices import COMMANDED_MODES, InterruptionMode, JobState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
 from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
+from hrc.cobots.models import Cobot
 from hrc_gateway import urua
 
 SLOW_OVERRIDE_PERCENT = 10.0
@@ -34,10 +40,11 @@ CLAIM_EXPIRES: Final = dt.timedelta(minutes=2)
 
 def interrupt_cobot(interruption_id: int) -> None:
     """Pauses (or slows) the cobot for an interruption still open; never twice."""
-    claimed = _claim(interruption_id, Q(ended_at__isnull=True, paused_at__isnull=True))
-    if claimed is None:
+    won = _claim(interruption_id, Q(ended_at__isnull=True, paused_at__isnull=True))
+    if won is None:
         return
-    error = _command(claimed, pause=True)
+    claimed, cobot = won
+    error = _command(claimed, cobot, pause=True)
     with transaction.atomic():
         if error:
             _record(claimed, error=f"pause: {error}")
@@ -53,33 +60,52 @@ def resume_cobot(interruption_id: int) -> None:
 
     A resume that fails is left for the sweeper, which sends it again until it succeeds.
     """
-    claimed = _claim(interruption_id, Q(ended_at__isnull=False, resumed_at__isnull=True))
-    if claimed is None:
+    won = _claim(interruption_id, Q(ended_at__isnull=False, resumed_at__isnull=True))
+    if won is None:
         return
+    claimed, cobot = won
     others = Interruption.objects.filter(
-        cobot=claimed.cobot, ended_at__isnull=True, paused_at__isnull=False
+        cobot=cobot, mode=claimed.mode, ended_at__isnull=True, paused_at__isnull=False
     ).exclude(pk=claimed.pk)
     needed = claimed.paused_at is not None and not others.exists()
-    needed = needed and claimed.cobot.stopped_at is None  # a STOP's resume restarts it
-    error = _command(claimed, pause=False) if needed else ""
+    needed = needed and cobot.stopped_at is None  # a STOP's resume restarts it
+    error = _command(claimed, cobot, pause=False) if needed else ""
     with transaction.atomic():
         if error:
             _record(claimed, error=f"resume: {error}")
             return
         _record(claimed, resumed_at=timezone.now())
-        ring_next_job_on_commit(claimed.cobot_id)  # the queue waited for this to settle
+        ring_next_job_on_commit(cobot.pk)  # the queue waited for this to settle
 
 
-def _claim(interruption_id: int, due: Q) -> Interruption | None:
-    """The interruption, once this sender alone may command its cobot for it; None when it is
-    not `due`, or another sender holds it."""
+def set_speed_before_step(cobot_id: int) -> bool:
+    """Gives the cobot the speed its next step runs at, before the step goes: full speed
+    restored after the slowdowns that ended, then slowed for those still open (a step that
+    starts beside an operator); whether none is left unsent (another sender may hold one)."""
+    slowdowns = Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.SLOW)
+    restores = slowdowns.filter(ended_at__isnull=False, resumed_at__isnull=True)
+    for interruption_id in restores.values_list("pk", flat=True):
+        resume_cobot(interruption_id)
+    pending = slowdowns.filter(ended_at__isnull=True, paused_at__isnull=True)
+    for interruption_id in pending.values_list("pk", flat=True):
+        interrupt_cobot(interruption_id)
+    return not restores.exists() and not pending.exists()
+
+
+def _claim(interruption_id: int, due: Q) -> tuple[Interruption, Cobot] | None:
+    """The interruption and its cobot, once this sender alone may command the cobot for it;
+    None when it is not `due` (nor a pause or a slowdown), or another sender holds it."""
     now = timezone.now()
     free = Q(claimed_at__isnull=True) | Q(claimed_at__lt=now - CLAIM_EXPIRES)
     with transaction.atomic():
-        won = Interruption.objects.filter(due, free, pk=interruption_id).update(claimed_at=now)
+        won = Interruption.objects.filter(
+            due, free, pk=interruption_id, mode__in=COMMANDED_MODES
+        ).update(claimed_at=now)
     if not won:
         return None
-    return Interruption.objects.select_related("cobot").get(pk=interruption_id)
+    claimed = Interruption.objects.select_related("cobot").get(pk=interruption_id)
+    assert claimed.cobot is not None  # a pause or a slowdown holds a cobot's step
+    return claimed, claimed.cobot
 
 
 def _record(interruption: Interruption, **outcome: object) -> None:
@@ -87,11 +113,11 @@ def _record(interruption: Interruption, **outcome: object) -> None:
     Interruption.objects.filter(pk=interruption.pk).update(claimed_at=None, **outcome)
 
 
-def _command(interruption: Interruption, *, pause: bool) -> str:
+def _command(interruption: Interruption, cobot: Cobot, *, pause: bool) -> str:
     """Pauses or resumes (slows or restores the speed of) the cobot; "" when done, else why not."""
 
     def send() -> None:
-        driver = driver_for_cobot(interruption.cobot)
+        driver = driver_for_cobot(cobot)
         if interruption.mode == "slow":
             speed = SLOW_OVERRIDE_PERCENT if pause else FULL_OVERRIDE_PERCENT
             driver.write({urua.STATE_OVERRIDE: speed})
@@ -117,8 +143,8 @@ def ring_next_job_on_commit(cobot_id: int) -> None:
 
 
 def holding(cobot_id: int) -> QuerySet[Interruption]:
-    """The interruptions that keep the cobot paused or slowed."""
-    return Interruption.objects.filter(cobot_id=cobot_id).filter(
+    """The pauses that keep the cobot paused (a slowed cobot may run)."""
+    return Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.PAUSE).filter(
         Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
 
@@ -130,10 +156,9 @@ def holds_cobot(cobot_id: int) -> bool:
 
 def to_redo() -> list[tuple[Task, int]]:
     """Pauses that failed while the interruption is open, resumes not yet done after it ended."""
-    pauses = Interruption.objects.filter(ended_at__isnull=True, paused_at__isnull=True).exclude(
-        error=""
-    )
-    resumes = Interruption.objects.filter(ended_at__isnull=False, resumed_at__isnull=True)
+    commanded = Interruption.objects.filter(mode__in=COMMANDED_MODES)
+    pauses = commanded.filter(ended_at__isnull=True, paused_at__isnull=True).exclude(error="")
+    resumes = commanded.filter(ended_at__isnull=False, resumed_at__isnull=True)
     return [(Task.INTERRUPT_COBOT, pk) for pk in pauses.values_list("pk", flat=True)] + [
         (Task.RESUME_COBOT, pk) for pk in resumes.values_list("pk", flat=True)
     ]

@@ -38,6 +38,7 @@ from hrc.cases.choices import (
     CaseStatus,
     EventType,
     IncidentKind,
+    InterruptionMode,
     JobState,
     WorkItemKind,
     WorkItemState,
@@ -192,7 +193,8 @@ def _lease_if_ready(
     # Asked again under the locks: the hold may have ended since the queue was read (it ends
     # in a transaction of its own, then rings the doorbell).
     waiting = why_held(cobot.pk, other_than=case.pk) if held else ""
-    waiting = waiting or _why_waiting(case, net, item)
+    if not waiting and (waiting := _why_waiting(case, net, item)):
+        case.save(update_fields=["last_seq"])  # the wait is recorded (progress.keep_out)
     if not waiting and item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
     if waiting:
@@ -228,21 +230,22 @@ def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
 
 
 def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
-    """Why a cobot task must not start now although the marking allows it; "" when it may."""
-    for pair in net.space_pairs:
-        if pair.cobot_task != item.task:
-            continue
-        operator = WorkItem.objects.filter(
-            case=case, task=pair.operator_task, state=WorkItemState.RUNNING
-        ).first()
-        if operator is not None:
-            return f"an operator is in the shared area ({operator.label}; space constraint)"
-    return ""
+    """Why a cobot task must not start now although the marking allows it; "" when it may.
+
+    A step kept out of a shared area waits, recorded as an interruption of its task until
+    the task in the area completes (which rings this job's doorbell: progress)."""
+    kept_out = progress.kept_out_by(case, net, item)
+    if kept_out is None:
+        return ""
+    if item.state != WorkItemState.OFFERED:  # started, then paused: the pause is its record
+        return f"{kept_out[1].label} is in the shared area (space constraint)"
+    return progress.keep_out(case, item, *kept_out)
 
 
 def _unsettled_interruptions(cobot: Cobot | int) -> QuerySet[Interruption]:
-    """The interruptions that keep the cobot (or the cobot of that id) paused or slowed."""
-    return Interruption.objects.filter(cobot=cobot).filter(
+    """The pauses that keep the cobot (or the cobot of that id) from taking a step: not yet
+    over, or not yet resumed. A slowed cobot takes steps (its worker sets their speed)."""
+    return Interruption.objects.filter(cobot=cobot, mode=InterruptionMode.PAUSE).filter(
         Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
     )
 
@@ -255,6 +258,11 @@ def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
         on_sent()  # a call (an inspection, say) may take a while: tablets need not wait for it
         return _call_device(driver, lease)
     _prepare(driver, lease.cobot.pk, command["program"], lease.timeout)
+    if not interruptions.set_speed_before_step(lease.cobot.pk):
+        raise CobotPaused(
+            f"{driver.name}'s speed for an operator in its shared area is not set yet; "
+            "the step waits until it is."
+        )
     step = StepCommand(
         step=command["number"], fence=Fence(lease.job_id, lease.attempt),
         workspace=command["workspace"], poses=command["poses"],

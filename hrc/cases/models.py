@@ -171,17 +171,24 @@ class Job(models.Model):
 
 
 class Interruption(models.Model):
-    """A cobot task paused or slowed while an operator works in a shared area (space constraint).
+    """A task held while another works in a shared area (space constraint): a cobot's step
+    paused or slowed while it runs, or a task kept out until the other completes (an
+    operator refused, a cobot's step waiting). `work_item` is the task held, `by_work_item`
+    the one in the area; both actors are theirs (WorkItem.actor).
 
-    The pause and the resume are each sent at most once, by the task that claimed
-    the row (claimed_at) and sends outside any transaction (hrc.cases.interruptions);
-    a resume that finds no pause sent marks it never needed.
+    For a pause or a slowdown the command and its undoing are each sent at most once, by
+    the task that claimed the row (claimed_at) and sends outside any transaction
+    (hrc.cases.interruptions); a resume that finds no pause sent marks it never needed.
+    A wait or a refusal sends nothing: it only ends.
     """
 
     case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="interruptions")
     work_item = models.ForeignKey(WorkItem, on_delete=models.CASCADE, related_name="interruptions")
-    operator_work_item = models.ForeignKey(WorkItem, on_delete=models.CASCADE, related_name="+")
-    cobot = models.ForeignKey(Cobot, on_delete=models.PROTECT, related_name="interruptions")
+    by_work_item = models.ForeignKey(WorkItem, on_delete=models.CASCADE, related_name="+")
+    cobot = models.ForeignKey(
+        Cobot, on_delete=models.PROTECT, related_name="interruptions", null=True, blank=True,
+        help_text="The held task's cobot; none when an operator is refused.",
+    )  # fmt: skip
     mode = models.CharField(max_length=10, choices=InterruptionMode.choices)
     started_at = models.DateTimeField(auto_now_add=True)
     ended_at = models.DateTimeField(null=True, blank=True)
@@ -196,12 +203,19 @@ class Interruption(models.Model):
         ordering = ["started_at", "id"]
 
     def __str__(self) -> str:
-        return f"{self.mode} of {self.cobot_id} for work item {self.work_item_id}"
+        return f"{self.mode} of work item {self.work_item_id} by {self.by_work_item_id}"
 
     @property
     def settled(self) -> bool:
-        """Over, and the cobot no longer paused by it."""
+        """Over, and the cobot no longer paused (or slowed) by it."""
         return self.ended_at is not None and (self.paused_at is None or self.resumed_at is not None)
+
+    @property
+    def seconds(self) -> float | None:
+        """How long it lasted; None while it goes on."""
+        if self.ended_at is None:
+            return None
+        return round((self.ended_at - self.started_at).total_seconds(), 3)
 
 
 class Incident(models.Model):

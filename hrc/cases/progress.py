@@ -22,11 +22,13 @@ from django.utils import timezone
 
 from hrc.cases import dispatch
 from hrc.cases.choices import (
+    COMMANDED_MODES,
     OPEN_CASE_STATUSES,
     OPEN_WORK_ITEM_STATES,
     CaseStatus,
     EventType,
     IncidentKind,
+    InterruptionMode,
     JobState,
     Resolution,
     WorkItemKind,
@@ -39,6 +41,7 @@ from hrc.cases.selectors import performable_by
 from hrc.engine.commands import cobot_command
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import (
+    AreaRule,
     CaseNet,
     NotEnabled,
     Outgoing,
@@ -260,13 +263,14 @@ def _withdraw(case: Case, item: WorkItem, why: str) -> None:
 
 
 def start_task(case: Case, net: CaseNet, item: WorkItem, user: User | None) -> None:
-    """Fires the task's start; interrupts the cobots it shares a space with. Raises NotEnabled."""
+    """Fires the task's start; pauses or slows the cobots it shares a space with (or itself, a
+    step starting slowly beside an operator). Raises NotEnabled."""
     before = Marking(case.marking)
     after = net.start(before, item.task)
     case.marking = dict(after)
     item.state, item.started_at = WorkItemState.RUNNING, timezone.now()
     record_event(case, EventType.TASK_STARTED, item=item, user=user, before=before, after=after)
-    if item.kind == WorkItemKind.OPERATOR:
+    if item.task in net.space_tasks:
         _interrupt_shared_space(case, net, item)
 
 
@@ -293,7 +297,7 @@ def complete_task(
     if message is not None:
         send_message(case, message, item.task)
     if item.task in net.space_tasks:  # only a space constraint's tasks are ever interrupted
-        _end_interruptions(case, Q(work_item=item) | Q(operator_work_item=item))
+        _end_interruptions(case, Q(work_item=item) | Q(by_work_item=item))
 
 
 def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
@@ -417,32 +421,101 @@ def send_message(case: Case, message: Outgoing, transition: str) -> Message:
     return row
 
 
-def _interrupt_shared_space(case: Case, net: CaseNet, operator_item: WorkItem) -> None:
-    for pair in net.space_pairs:
-        if pair.operator_task != operator_item.task:
-            continue
-        cobot_item = WorkItem.objects.filter(
-            case=case, task=pair.cobot_task, state=WorkItemState.RUNNING
-        ).first()
-        if cobot_item is None or cobot_item.cobot_id is None:
-            continue  # not running: the cobot's job waits for the operator instead (jobs.py)
+def kept_out_by(case: Case, net: CaseNet, item: WorkItem) -> tuple[AreaRule, WorkItem] | None:
+    """The space rule and the running task that keep `item` from starting now (an operator is
+    refused, a cobot's step waits); None when nothing in a shared area does."""
+    for rule in net.space_rules(item.task):
+        if rule.keeps_out and rule.held == item.task:
+            occupant = _running(case, rule.by)
+            if occupant is not None:
+                return rule, occupant
+    return None
+
+
+def keep_out(case: Case, item: WorkItem, rule: AreaRule, occupant: WorkItem) -> str:
+    """Records that `item` is kept out of the area `occupant` works in (once while it lasts:
+    the interruption ends when the occupant completes); returns why, naming the task in the
+    area and who does it. Call while holding the case row lock; the caller saves the case."""
+    already = Interruption.objects.filter(
+        case=case, work_item=item, by_work_item=occupant, ended_at__isnull=True
+    ).exists()
+    if not already:
         interruption = Interruption.objects.create(
-            case=case, work_item=cobot_item, operator_work_item=operator_item,
-            cobot_id=cobot_item.cobot_id, mode=pair.mode,
+            case=case, work_item=item, by_work_item=occupant, cobot_id=item.cobot_id,
+            mode=InterruptionMode.REFUSED if rule.mode == "refused" else InterruptionMode.WAIT,
         )  # fmt: skip
-        record_event(case, EventType.TASK_INTERRUPTED, item=cobot_item,
-                detail={"interruption": interruption.pk, "by": operator_item.task, "mode": pair.mode})  # fmt: skip
-        dispatch.send_on_commit(Task.INTERRUPT_COBOT, interruption.pk)
+        record_event(case, EventType.TASK_KEPT_OUT, item=item, detail=_detail(interruption, occupant))  # fmt: skip
+    return (
+        f"{occupant.label} ({_performer(occupant)}) is in the shared area; {item.label} "
+        "can start once it is done (space constraint)."
+    )
+
+
+def _interrupt_shared_space(case: Case, net: CaseNet, entering: WorkItem) -> None:
+    for rule in net.space_rules(entering.task):
+        if rule.keeps_out:
+            continue  # checked before the start: kept_out_by
+        other = _running(case, rule.by if rule.held == entering.task else rule.held)
+        if other is None:
+            continue  # not running: nothing shares the area now
+        held, by = (entering, other) if rule.held == entering.task else (other, entering)
+        if held.cobot_id is None:
+            continue
+        interruption = Interruption.objects.create(
+            case=case, work_item=held, by_work_item=by, cobot_id=held.cobot_id, mode=rule.mode
+        )
+        record_event(case, EventType.TASK_INTERRUPTED, item=held, detail=_detail(interruption, by))
+        if held is not entering:
+            # A step starting slowly is slowed by its worker before it goes (jobs._execute).
+            dispatch.send_on_commit(Task.INTERRUPT_COBOT, interruption.pk)
+
+
+def _running(case: Case, task: str) -> WorkItem | None:
+    return (
+        WorkItem.objects.filter(case=case, task=task, state=WorkItemState.RUNNING)
+        .select_related("claimed_by", "cobot")
+        .first()
+    )
+
+
+def _performer(item: WorkItem) -> str:
+    """Who does the item: its operator's user name, or its cobot's name."""
+    if item.cobot is not None:
+        return item.cobot.name
+    return item.claimed_by.username if item.claimed_by is not None else item.actor
+
+
+def _detail(interruption: Interruption, by: WorkItem) -> dict[str, Any]:
+    return {
+        "interruption": interruption.pk, "by": by.task, "by_actor": by.actor,
+        "by_performer": _performer(by), "mode": interruption.mode,
+    }  # fmt: skip
 
 
 def _end_interruptions(case: Case, which: Q) -> None:
     for interruption in Interruption.objects.filter(which, case=case, ended_at__isnull=True):
         interruption.ended_at = timezone.now()
         interruption.save(update_fields=["ended_at"])
+        if interruption.mode not in COMMANDED_MODES:
+            # Kept out: the task may start now (its start is its event); a waiting step goes.
+            if interruption.mode == InterruptionMode.WAIT:
+                _ring_for_waiting_step(interruption.work_item_id)
+            continue
         seconds = (interruption.ended_at - interruption.started_at).total_seconds()
         record_event(case, EventType.TASK_RESUMED, item=interruption.work_item,
                 detail={"interruption": interruption.pk, "seconds": round(seconds, 3)})  # fmt: skip
         dispatch.send_on_commit(Task.RESUME_COBOT, interruption.pk)
+
+
+def _ring_for_waiting_step(item_id: int) -> None:
+    """The step that waited for the area may go: its cobot's doorbell rings after the commit."""
+    job_id = (
+        Job.objects.filter(work_item_id=item_id, state=JobState.QUEUED)
+        .values_list("pk", flat=True)
+        .first()
+    )
+    if job_id is not None:
+        dispatch.send_on_commit(Task.RUN_JOB, job_id)
 
 
 def _end_hold(job: Job) -> None:

@@ -283,7 +283,7 @@ def interruptions_of(case: Case) -> QuerySet[Interruption]:
     """The case's interruptions in the order they began, with both tasks and the cobot."""
     return (
         Interruption.objects.filter(case=case)
-        .select_related("work_item", "operator_work_item", "cobot")
+        .select_related("work_item", "by_work_item", "cobot")
         .order_by("started_at", "id")
     )
 

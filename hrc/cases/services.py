@@ -31,7 +31,7 @@ from hrc.cases.nets import case_net
 from hrc.cases.progress import check_operator_task as check_operator_task  # the API asks it too
 from hrc.cases.selectors import performers_of
 from hrc.engine.forms import form_problems
-from hrc.engine.runtime import NotEnabled
+from hrc.engine.runtime import CaseNet, NotEnabled
 from hrc.engine.startdata import check_start_data
 from hrc.errors import Conflict, Invalid
 from hrc.patterns.models import PatternVersion
@@ -221,7 +221,10 @@ def reassign_work_item(item: WorkItem, *, by: User, to: User | None) -> WorkItem
 
 
 def start_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
-    """Starts an operator task (claiming it if nobody has); the other tasks of a choice withdraw."""
+    """Starts an operator task (claiming it if nobody has); the other tasks of a choice withdraw.
+
+    Conflict naming the task and its performer while another operator's task is in the shared
+    area (space constraint); the refusal is recorded as an interruption of this task."""
     with transaction.atomic():
         case, item = progress.lock_operator_item(item, user)
         if item.state == WorkItemState.CLAIMED and item.claimed_by_id != user.pk:
@@ -231,15 +234,27 @@ def start_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
         if case.status != CaseStatus.RUNNING:
             raise Conflict(f"Case {case.pk} is {case.status}: nothing can start now.")
         net = case_net(case.version)
-        try:
-            progress.start_task(case, net, item, user)
-        except NotEnabled as refused:
-            raise Conflict(str(refused)) from None
-        item.claimed_by = user
-        item.save(update_fields=["state", "started_at", "claimed_by"])
-        progress.advance(case, net)
-        case.save()
+        kept_out = progress.kept_out_by(case, net, item)
+        if kept_out is not None:
+            # Recorded and committed, then refused: the refusal is part of the case's history.
+            refusal = progress.keep_out(case, item, *kept_out)
+            case.save()
+        else:
+            _start_operator_task(case, net, item, user)
+    if kept_out is not None:
+        raise Conflict(refusal)
     return item
+
+
+def _start_operator_task(case: Case, net: CaseNet, item: WorkItem, user: User) -> None:
+    try:
+        progress.start_task(case, net, item, user)
+    except NotEnabled as refused:
+        raise Conflict(str(refused)) from None
+    item.claimed_by = user
+    item.save(update_fields=["state", "started_at", "claimed_by"])
+    progress.advance(case, net)
+    case.save()
 
 
 def complete_work_item(

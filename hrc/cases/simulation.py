@@ -61,6 +61,7 @@ from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
 from hrc.patterns import services as pattern_services
 from hrc.patterns.models import PatternVersion
+from hrc_gateway.sim.state import read_step_log
 
 # The events a run reports, as issue #4's run_pattern contract names them.
 REPORTED = {
@@ -249,6 +250,10 @@ class Simulation:
         return int(driver.read("Simulator/Executions")), list(
             driver.read("Simulator/ExecutedSteps")
         )
+
+    def step_log(self, actor: str) -> list[dict[str, Any]]:
+        """The steps the actor's simulated cobot ran: when (Unix seconds) and at what override."""
+        return read_step_log(self.workdir / f"{self._cobot_names[actor]}.json")
 
     def close(self) -> None:
         self._stop.set()

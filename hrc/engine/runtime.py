@@ -2,7 +2,7 @@
 
 A `CaseNet` is a published pattern compiled once for running: its execution
 net (execution.py), each task's configuration, the guards and messages of
-its silent transitions, the operator/cobot pairs of its space constraints,
+its silent transitions, the task pairs of its space constraints,
 and the data its cases start with. It holds no case state: every method takes the marking (and
 case data) and returns the next marking, so the database row stays the one
 truth and the same rule serves the runtime, the token game and the tests.
@@ -13,7 +13,7 @@ truth and the same rule serves the runtime, the token game and the tests.
   tokens, so the other tasks of a deferred choice are no longer startable.
 - time and func constraints are places of the execution net, so `start` and
   `complete` enforce them; space constraints are the runtime's to honour
-  (`space_partners`).
+  (`space_rules`: who waits and who is interrupted, `entering_area`).
 """
 
 import copy
@@ -33,6 +33,7 @@ from hrc.engine.taskconfig import (
     initial_data,
     message_of,
     send_of,
+    space_modes,
     task_config,
 )
 
@@ -51,11 +52,56 @@ class NotEnabled(Exception):
 
 @dataclass(frozen=True)
 class SpacePair:
-    """A space constraint's operator task and cobot task."""
+    """A space constraint's two tasks, their actors' types and how they share the area."""
 
-    operator_task: str
-    cobot_task: str
-    mode: str  # "pause" or "slow": how the cobot is interrupted
+    first: str
+    second: str
+    kinds: tuple[str, str]  # the actor types of first and second: "operator" or "cobot"
+    mode: str  # one of taskconfig.SPACE_MODES for the two types
+
+    def other(self, task: str) -> str:
+        return self.second if task == self.first else self.first
+
+    def kind(self, task: str) -> str:
+        return self.kinds[0] if task == self.first else self.kinds[1]
+
+
+@dataclass(frozen=True)
+class AreaRule:
+    """What happens when a task starts while its space partner runs in the shared area: `held`
+    is kept out ("refused": an operator, "wait": a cobot's step), or interrupted while it runs
+    ("pause", "slow": a cobot), for as long as `by` runs."""
+
+    held: str
+    by: str
+    mode: str  # "refused", "wait", "pause" or "slow"
+
+    @property
+    def keeps_out(self) -> bool:
+        """The held task may not start until `by` has completed."""
+        return self.mode in ("refused", "wait")
+
+
+def entering_area(pair: SpacePair, entering: str) -> AreaRule:
+    """Who waits and who is interrupted when `entering` starts while the other task of `pair`
+    runs. A person is never paused by software: between operators the later one is refused;
+    a cobot beside an operator is paused (it waits when it is the later one) or slowed (the
+    later one starts slowly); between cobots the later step waits, or starts and pauses the
+    one running."""
+    occupant = pair.other(entering)
+    kinds = (pair.kind(entering), pair.kind(occupant))
+    if kinds == ("operator", "operator"):
+        return AreaRule(entering, occupant, "refused")
+    if kinds == ("cobot", "cobot"):
+        if pair.mode == "pause":
+            return AreaRule(occupant, entering, "pause")
+        return AreaRule(entering, occupant, "wait")
+    cobot, operator = (entering, occupant) if kinds[0] == "cobot" else (occupant, entering)
+    if pair.mode == "slow":
+        return AreaRule(cobot, operator, "slow")
+    if entering == cobot:
+        return AreaRule(cobot, operator, "wait")
+    return AreaRule(cobot, operator, "pause")
 
 
 @dataclass(frozen=True)
@@ -100,7 +146,7 @@ class CaseNet:
                 self.messages[transition.id] = message
         self.space_pairs = self._space_pairs()
         self.space_tasks = frozenset(
-            task for pair in self.space_pairs for task in (pair.operator_task, pair.cobot_task)
+            task for pair in self.space_pairs for task in (pair.first, pair.second)
         )
         # Tasks whose completion a constraint place can hold back (func): only
         # their finished steps need looking for again after each firing.
@@ -113,13 +159,22 @@ class CaseNet:
     def _space_pairs(self) -> tuple[SpacePair, ...]:
         pairs = []
         for constraint in self.pattern.constraints:
-            if constraint.type != "space":
+            first, second = constraint.source, constraint.target
+            modes = space_modes(self.pattern, first, second)
+            if constraint.type != "space" or not modes or first == second:
                 continue
-            kinds = {self.actor_type(t): t for t in constraint.elements}
-            if set(kinds) == {"operator", "cobot"}:
-                mode = "slow" if constraint.extra.get("interrupt") == "slow" else "pause"
-                pairs.append(SpacePair(kinds["operator"], kinds["cobot"], mode))
+            mode = constraint.extra.get("interrupt", modes[0])
+            kinds = (self.actor_type(first) or "", self.actor_type(second) or "")
+            pairs.append(SpacePair(first, second, kinds, mode if mode in modes else modes[0]))
         return tuple(pairs)
+
+    def space_rules(self, entering: str) -> list[AreaRule]:
+        """For each space partner of `entering`, what happens if it runs when `entering` starts."""
+        return [
+            entering_area(pair, entering)
+            for pair in self.space_pairs
+            if entering in (pair.first, pair.second)
+        ]
 
     def initial_data(self) -> dict[str, Any]:
         """The data a case starts with, a copy of its own (compiled nets are shared)."""

@@ -69,6 +69,14 @@ DEVICE_CALLS: Final[Mapping[str, tuple[str, tuple[str, ...], tuple[str, ...]]]] 
 
 # How a space constraint interrupts the cobot (its "interrupt" key); pause by default.
 INTERRUPT_MODES: Final = ("pause", "slow")
+# The "interrupt" modes per pair of actor types (the pair sorted), the first the default:
+# beside an operator a cobot pauses or slows; of two cobots the later step waits for the
+# area or pauses the running one; two operators have no choice (the second is refused).
+SPACE_MODES: Final[dict[tuple[str, str], tuple[str, ...]]] = {
+    ("cobot", "operator"): INTERRUPT_MODES,
+    ("cobot", "cobot"): ("wait", "pause"),
+    ("operator", "operator"): ("wait",),
+}
 
 # Names expressions may use: case data everywhere, a task's result in its outputs, the case
 # itself (id, reference) in what messages carry and match, so a case can address its own.
@@ -346,6 +354,15 @@ def initial_data(pattern: Pattern) -> dict[str, Any]:
     return dict(raw)
 
 
+def space_modes(pattern: Pattern, first: str, second: str) -> tuple[str, ...]:
+    """The "interrupt" modes a space constraint between these tasks may have, the default
+    first; () when either is not a task of an operator or a cobot."""
+    performers = {t.id: t.performer for _, t in pattern.transitions()}
+    actors = [pattern.actor(performers.get(task) or "") for task in (first, second)]
+    kinds = sorted(actor.type for actor in actors if actor is not None)
+    return SPACE_MODES.get((kinds[0], kinds[1]), ()) if len(kinds) == 2 else ()
+
+
 def config_issues(pattern: Pattern) -> list[Issue]:
     """Every malformed task, guard or message configuration, as `task-config` errors."""
     issues = []
@@ -376,14 +393,15 @@ def config_issues(pattern: Pattern) -> list[Issue]:
             where = sentence(names.node(transition.id))
             issues.append(error("task-config", f"{where}: {problem.problem}", transition.id))
     for constraint in pattern.constraints:
-        mode = constraint.extra.get("interrupt", "pause")
-        if constraint.type == "space" and mode not in INTERRUPT_MODES:
+        modes = space_modes(pattern, constraint.source, constraint.target)
+        mode = constraint.extra.get("interrupt", modes[0] if modes else "pause")
+        if constraint.type == "space" and modes and mode not in modes:
             issues.append(
                 error(
                     "task-config",
                     f"The space constraint {names.name(constraint.source)} → "
                     f"{names.name(constraint.target)} has "
-                    f"interrupt {mode!r}; it must be one of {', '.join(INTERRUPT_MODES)}.",
+                    f"interrupt {mode!r}; it must be one of {', '.join(modes)}.",
                     constraint.source,
                     constraint.target,
                 )

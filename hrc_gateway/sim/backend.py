@@ -273,6 +273,7 @@ class SimBackend(Backend):
             faults=self.faults,
             publish=self._publish,
             persist=self._persist,
+            step_log=self._state_file.append_step if self._state_file is not None else None,
         )
         self._program_task = asyncio.create_task(
             self._run_program(runner), name=f"sim {self.name} {program.name}"

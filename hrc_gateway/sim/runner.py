@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import enum
 import logging
+import time
 from collections.abc import Awaitable, Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -112,6 +113,7 @@ class StepRunner:
         faults: Faults,
         publish: Publisher,
         persist: Callable[[], Awaitable[None]],
+        step_log: Callable[[dict[str, Any]], None] | None = None,
     ) -> None:
         self.program = program
         self.state = state
@@ -121,6 +123,9 @@ class StepRunner:
         self._faults = faults
         self._publish = publish
         self._persist = persist
+        # Each step that ran, when and at what speed override (a test compares cobots' logs).
+        self._step_log = step_log
+        self._lowest_override = 100.0
 
     async def run(self) -> None:
         if not self.state.started:
@@ -171,7 +176,16 @@ class StepRunner:
         )
         await self._persist()  # the record is on disk before the arm moves
         await self._publish(self._log.published_values())
+        started, override = time.time(), self._robot.state.override
+        self._lowest_override = override
         await self._carry_out(self.state.in_progress, plan)
+        if self._step_log is not None:
+            self._step_log({
+                "token": list(request.token), "step": request.step, "program": self.program.name,
+                "started": started, "ended": time.time(), "override": override,
+                "lowest_override": self._lowest_override,
+                "override_at_end": self._robot.state.override,
+            })  # fmt: skip
         return urua.OUTCOME_RAN
 
     async def _carry_out(self, step: InProgress, plan: Plan | None = None) -> None:
@@ -193,6 +207,7 @@ class StepRunner:
                 )
             else:
                 await self._robot.dwell(action.seconds, slowdown=self._faults.slowdown)
+            self._lowest_override = min(self._lowest_override, self._robot.state.override)
             step.done = index + 1
             if step.done < len(plan.actions):  # after the last, the acknowledgement saves
                 await self._persist()

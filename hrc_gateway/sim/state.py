@@ -9,6 +9,10 @@ The file is replaced atomically (write, then rename) but not fsync'ed: it
 survives the gateway process being killed, which is what the simulator has to
 stand in for, and a step stays in the millisecond range (an fsync per
 lifecycle point would not). A power cut may lose the last writes.
+
+Next to it the step log (`read_step_log`) keeps each step that ran: when it
+started and ended and at what speed override, for tests that check what the
+cobots did (two sharing an area never at once, a step slowed for an operator).
 """
 
 from __future__ import annotations
@@ -24,6 +28,27 @@ from typing import Any, Final
 logger = logging.getLogger(__name__)
 
 FORMAT: Final = 1
+
+
+def step_log_path(state_file: Path) -> Path:
+    """The step log next to a state file: one JSON line per step that ran (token, step, program,
+    started and ended in Unix seconds, the speed override at its start, lowest and end)."""
+    return state_file.with_name(state_file.name + ".steps")
+
+
+def read_step_log(state_file: Path) -> list[dict[str, Any]]:
+    """The steps the simulator at `state_file` ran, in order; a torn last line is dropped."""
+    try:
+        lines = step_log_path(state_file).read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        return []
+    steps = []
+    for line in lines:
+        try:
+            steps.append(json.loads(line))
+        except json.JSONDecodeError:
+            break
+    return steps
 
 
 class CorruptState(ValueError):
@@ -43,6 +68,8 @@ class StateFile:
         self.path = path
         # The execution log's journal, one "step_id attempt ran" line per token judged.
         self.journal_path = path.with_name(path.name + ".journal")
+        # The steps that ran, one JSON object a line: when, and at what speed override.
+        self.steps_path = step_log_path(path)
         self._lock = threading.Lock()
         self._requested = 0
         self._written = 0
@@ -82,6 +109,12 @@ class StateFile:
         tmp.write_text("".join(f"{a} {b} {c}\n" for a, b, c in entries), encoding="utf-8")
         os.replace(tmp, self.journal_path)
         self.journal_lines = len(entries)
+
+    def append_step(self, record: dict[str, Any]) -> None:
+        """Appends a step that ran to the step log (what a test reads; nothing reads it back)."""
+        self.steps_path.parent.mkdir(parents=True, exist_ok=True)
+        with self.steps_path.open("a", encoding="utf-8") as steps:
+            steps.write(json.dumps(record, sort_keys=True) + "\n")
 
     def load(self) -> dict[str, Any] | None:
         """The saved state; None when there is no file; CorruptState when it can't be read."""

@@ -131,25 +131,88 @@ def test_a_target_that_never_started_or_has_no_source_bar_gets_no_arrow() -> Non
 
 def test_interruptions_become_marks_in_time_order() -> None:
     interruptions = [
-        InterruptionRow(8, 1, 2, 3, 1, "ur5e-left", "slow", at(60), None, None, None),
-        InterruptionRow(7, 1, 2, 3, 1, "ur5e-left", "pause", at(50), at(55), at(50), at(55)),
+        InterruptionRow(
+            8, 1, 2, "c", 3, "to1", "", "o", 1, "ur5e-left", "slow", at(60), None, None, None
+        ),
+        InterruptionRow(
+            7, 1, 2, "c", 3, "to1", "", "o", 1, "ur5e-left", "pause", at(50), at(55), at(50), at(55)
+        ),
     ]
     gantt = build_gantt(
         1, started_at=at(0), ended_at=None, now=at(120), actors=ACTORS,
         items=[item(2, "tc1", "c", 30, 40, None, "running"), item(3, "to2", "o", 45, 50, None, "running")],
         constraints=[], interruptions=interruptions,
     )  # fmt: skip
-    assert [(m.interruption, m.mode, m.work_item, m.operator_work_item) for m in gantt.marks] == [
+    assert [(m.interruption, m.mode, m.work_item, m.by_work_item) for m in gantt.marks] == [
         (7, "pause", 2, 3),
         (8, "slow", 2, 3),
     ]
+
+
+def test_every_kind_of_interruption_is_marked_on_the_held_tasks_bar_naming_the_other() -> None:
+    actors = [*ACTORS, ActorRow("p", "operator", "paul")]
+    interruptions = [
+        # Paul refused while Olivia's to1 was in the area, then the cobot's step waiting for it.
+        InterruptionRow(
+            1,
+            1,
+            3,
+            "p",
+            1,
+            "to1",
+            "to1 label",
+            "o",
+            None,
+            None,
+            "refused",
+            at(12),
+            at(30),
+            None,
+            None,
+        ),
+        InterruptionRow(
+            2,
+            1,
+            2,
+            "c",
+            1,
+            "to1",
+            "to1 label",
+            "o",
+            1,
+            "ur5e-left",
+            "wait",
+            at(15),
+            at(30),
+            None,
+            None,
+        ),
+    ]
+    gantt = build_gantt(
+        1, started_at=at(0), ended_at=at(60), now=at(60), actors=actors,
+        items=[item(1, "to1", "o", 0, 10, 30), item(2, "tc1", "c", 15, 30, 50),
+               item(3, "to2", "p", 11, 30, 40)],
+        constraints=[], interruptions=interruptions,
+    )  # fmt: skip
+
+    drawing = draw_gantt(gantt, width=1024 + LABEL_WIDTH + RIGHT_MARGIN)
+
+    bars = {b.bar.work_item: b for b in drawing.bars}
+    refused, waited = drawing.marks
+    assert (refused.y, waited.y) == (bars[3].y, bars[2].y)  # on the held task's row
+    assert refused.x < waited.x < bars[2].x  # from when it was kept out until it could start
+    assert (refused.word, waited.word) == ("refused", "waited")
+    assert refused.title == "p refused: to1 label (o) in the shared area"
+    assert waited.title == "c (ur5e-left) waited: to1 label (o) in the shared area"
 
 
 # Drawing -----------------------------------------------------------------------------------
 
 
 def test_the_drawing_maps_time_to_x_between_the_labels_and_the_right_margin() -> None:
-    interruption = InterruptionRow(7, 1, 2, 1, 1, "ur5e-left", "pause", at(50), at(60), None, None)
+    interruption = InterruptionRow(
+        7, 1, 2, "c", 1, "to1", "", "o", 1, "ur5e-left", "pause", at(50), at(60), None, None
+    )
     gantt = build_gantt(
         1, started_at=at(0), ended_at=at(100), now=at(120), actors=ACTORS,
         items=[item(1, "to1", "o", 0, 10, 30), item(2, "tc1", "c", 30, 40, 90),

@@ -209,9 +209,15 @@ def test_a_versions_cycle_time_counts_completed_cases_and_its_window_spans_them_
         CaseRow(4, "running", at(300), None),
     ]
     interruptions = [
-        InterruptionRow(1, 2, 10, 11, 1, "cobot1", "pause", at(60), at(90), at(61), at(89)),
-        InterruptionRow(2, 2, 12, 13, 1, "cobot1", "slow", at(95), at(100), None, None),
-        InterruptionRow(3, 4, 14, 15, 1, "cobot1", "pause", at(310), None, at(311), None),
+        InterruptionRow(
+            1, 2, 10, "c", 11, "to1", "", "o", 1, "cobot1", "pause", at(60), at(90), at(61), at(89)
+        ),
+        InterruptionRow(
+            2, 2, 12, "c", 13, "to1", "", "o", 1, "cobot1", "slow", at(95), at(100), None, None
+        ),
+        InterruptionRow(
+            3, 4, 14, "c", 15, "to1", "", "o", 1, "cobot1", "pause", at(310), None, at(311), None
+        ),
     ]
     figures = version_figures(cases, [], [], interruptions, now=at(400), recent=3)
     assert figures.cases == 4

@@ -109,6 +109,8 @@ def test_the_gantt_chart_draws_a_bar_per_task_an_arrow_per_constraint_and_the_in
     marks = re.findall(r'class="interruption (\w+)" data-interruption="\d+" '
                        r'data-work-item="(\d+)"', svg)  # fmt: skip
     assert marks == [("pause", str(items["tc1"]))]
+    to2 = WorkItem.objects.get(case=case, task="to2")
+    assert f"paused: {to2.label} (o) in the shared area</title>" in svg
     assert 'class="now"' not in svg  # the case has ended
     assert "1:00" in svg  # the axis reaches the case's minute
     assert 'href="/api/analytics/xes/?case=' in html

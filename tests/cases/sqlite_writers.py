@@ -130,7 +130,7 @@ def pause_a_silent_cobot(case: Case, operator: Any) -> dict[str, Any]:
     )
     item = factories.open_work_item(case, "join")
     interruption = Interruption.objects.create(
-        case=case, work_item=item, operator_work_item=item, cobot=cobot,
+        case=case, work_item=item, by_work_item=item, cobot=cobot,
         mode=InterruptionMode.PAUSE,
     )  # fmt: skip
     started = time.monotonic()

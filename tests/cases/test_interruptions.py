@@ -64,7 +64,7 @@ def interruption(
     case = factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
     item = factories.open_work_item(case, "tc1")
     return Interruption.objects.create(
-        case=case, work_item=item, operator_work_item=item, cobot=cobot,
+        case=case, work_item=item, by_work_item=item, cobot=cobot,
         mode=InterruptionMode.PAUSE,
     )  # fmt: skip
 

@@ -62,7 +62,7 @@ def test_a_program_paused_for_an_operator_in_a_shared_area_is_not_played_and_the
     job = Job.objects.get(case=case)
     # The operator entered the shared area just after the job was leased: the cobot is paused.
     Interruption.objects.create(
-        case=case, work_item=job.work_item, operator_work_item=factories.open_work_item(case, "tc1"),
+        case=case, work_item=job.work_item, by_work_item=factories.open_work_item(case, "tc1"),
         cobot=cobot, mode="pause", paused_at=timezone.now(),
     )  # fmt: skip
     driver.call("PauseProgram")

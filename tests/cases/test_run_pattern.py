@@ -60,7 +60,7 @@ def check_trace(pattern: Pattern, trace: list[Event]) -> None:
     started: Counter[str] = Counter()
     completed: Counter[str] = Counter()
     interrupted: set[str] = set()
-    space = CaseNet(pattern).space_pairs
+    space_rules = CaseNet(pattern).space_rules
     for event in trace:
         task, kind = event["task"], event["event"]
         if kind == "task-started":
@@ -72,17 +72,14 @@ def check_trace(pattern: Pattern, trace: list[Event]) -> None:
                     assert started[supporter] > completed[supporter], (
                         f"func: {supporter} not running"
                     )
-            for pair in space:
-                if task == pair.cobot_task:
-                    # The cobot does not start into an operator's shared area.
-                    assert started[pair.operator_task] == completed[pair.operator_task], event
-                if (
-                    task == pair.operator_task
-                    and started[pair.cobot_task] > completed[pair.cobot_task]
-                ):
-                    assert pair.cobot_task in interrupted or _next_is_interruption(
-                        trace, event, pair.cobot_task
-                    )
+            for rule in space_rules(task):
+                occupant = rule.by if rule.held == task else rule.held
+                if started[occupant] == completed[occupant]:
+                    continue  # the other task is not in the area
+                # The task kept out never starts beside the other; a cobot interrupted is so
+                # from the moment both are in the area (one transaction: adjacent events).
+                assert not rule.keeps_out, f"{task} started beside {occupant}: {event}"
+                assert rule.held in interrupted or _next_is_interruption(trace, event, rule.held)
             started[task] += 1
         elif kind == "task-completed":
             assert started[task] == completed[task] + 1, f"{task} completed without running"
@@ -105,9 +102,38 @@ def check_trace(pattern: Pattern, trace: list[Event]) -> None:
 
 
 def _next_is_interruption(trace: list[Event], event: Event, cobot_task: str) -> bool:
-    """The operator's start and the cobot's interruption are one transaction: adjacent events."""
+    """A start and the interruption it causes are one transaction: adjacent events."""
     after = trace[trace.index(event) + 1 :]
     return any(e["event"] == "task-interrupted" and e["task"] == cobot_task for e in after[:3])
+
+
+@pytest.mark.django_db(transaction=True)
+def test_the_quality_inspection_keeps_its_operators_and_their_cobots_apart() -> None:
+    """The thesis' quality inspection: o1 and o2 share an area (to12, to21), each beside a cobot."""
+    path = next(p for p in EXAMPLES if p.stem == "coop_2o2c_quality_inspection")
+    events = run_pattern(path, "--cases", "2", "--time-scale", "0.02", "--seed", "3")
+    pattern = read_pattern(json.loads(path.read_text()))
+
+    for case in {e["case"] for e in events}:
+        trace = [e for e in events if e["case"] == case]
+        assert trace[-1]["event"] == "case-completed"
+        check_trace(pattern, trace)
+        assert not _overlapping(trace, "to12", "to21")
+
+
+def _overlapping(trace: list[Event], one: str, other: str) -> bool:
+    """Whether the two tasks ever ran at once in the trace."""
+    running: set[str] = set()
+    for event in trace:
+        if event["task"] not in (one, other):
+            continue
+        if event["event"] == "task-started":
+            running.add(event["task"])
+            if running == {one, other}:
+                return True
+        elif event["event"] == "task-completed":
+            running.discard(event["task"])
+    return False
 
 
 @pytest.mark.django_db(transaction=True)

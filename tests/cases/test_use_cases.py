@@ -142,7 +142,8 @@ def test_every_use_case_is_published_sound_with_its_declared_pattern() -> None:
             assert list(report.patterns) == [document["declared_pattern"]]
             assert report.warnings == ()
         if "variant" in stem:
-            assert "hrc's" in document["name"] and "variant" in document["name"], stem
+            assert "hrc's" in document["name"], stem
+            assert "variant" in document["name"], stem
 
 
 @pytest.mark.django_db(transaction=True)
@@ -339,7 +340,7 @@ def test_polishing_the_operator_follows_the_cobot_one_line_behind_in_its_area(
     assert run.executions == {"c": 7}  # six lines and home
     trace = run.case_trace(case)
     at = {(e["task"], e["event"]): i for i, e in enumerate(trace)}
-    overlapping = 0
+    overlapping = beside = 0
     for line in range(1, 7):
         # check_trace has kept the time constraint; here the lag itself: line k is checked
         # only after the cobot is done with it, and (but for the last) while it polishes k+1.
@@ -347,10 +348,15 @@ def test_polishing_the_operator_follows_the_cobot_one_line_behind_in_its_area(
         if line < 6:
             next_done = at[(f"tc_line{line + 1}", "task-completed")]
             overlapping += at[(f"to_line{line}", "task-started")] < next_done
+            # Both in the area at once (the operator may be done before the cobot starts).
+            beside += (
+                at[(f"to_line{line}", "task-started")] < next_done
+                and at[(f"tc_line{line + 1}", "task-started")] < at[(f"to_line{line}", "task-completed")]
+            )  # fmt: skip
     assert overlapping >= 3
-    # Cooperation: beside the operator's line k the cobot polishes line k + 1 slowly.
+    # Cooperation: beside the operator's line k the cobot polishes line k + 1 slowly, once.
     slowed = Interruption.objects.filter(case=case, mode="slow")
-    assert slowed.count() >= overlapping
+    assert slowed.count() == beside
     assert all(i.ended_at is not None for i in slowed)
 
 

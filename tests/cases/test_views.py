@@ -288,14 +288,14 @@ def test_interruptions_are_listed_with_their_durations(
     operator_item = step_case.work_items.get(task="to1")
     began = timezone.now() - dt.timedelta(seconds=75)
     over = Interruption.objects.create(
-        case=step_case, work_item=step, operator_work_item=operator_item, cobot=cobot,
+        case=step_case, work_item=step, by_work_item=operator_item, cobot=cobot,
         mode=InterruptionMode.PAUSE,
     )  # fmt: skip
     Interruption.objects.filter(pk=over.pk).update(
         started_at=began, ended_at=began + dt.timedelta(seconds=12.5)
     )
     ongoing = Interruption.objects.create(
-        case=step_case, work_item=step, operator_work_item=operator_item, cobot=cobot,
+        case=step_case, work_item=step, by_work_item=operator_item, cobot=cobot,
         mode=InterruptionMode.SLOW,
     )  # fmt: skip
     Interruption.objects.filter(pk=ongoing.pk).update(started_at=began)

@@ -86,7 +86,7 @@ def test_resume_releases_the_queues_and_restarts_no_cobot_an_interruption_holds(
     case = factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=held)
     item = factories.open_work_item(case, "tc1")
     Interruption.objects.create(
-        case=case, work_item=item, operator_work_item=item, cobot=held,
+        case=case, work_item=item, by_work_item=item, cobot=held,
         mode=InterruptionMode.PAUSE,
     )  # fmt: skip
     stops.stop_cell(organisation, "A", by=operator)

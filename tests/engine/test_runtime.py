@@ -418,7 +418,10 @@ def test_a_message_correlates_only_with_equal_keys() -> None:
 def test_space_constraints_pair_each_operator_task_with_its_cobot_task() -> None:
     net = CaseNet(read_pattern(two_lanes([("tc1", "to1", "space"), ("to2", "tc3", "space")])))
 
-    assert net.space_pairs == (SpacePair("to1", "tc1", "pause"), SpacePair("to2", "tc3", "pause"))
+    assert net.space_pairs == (
+        SpacePair("tc1", "to1", ("cobot", "operator"), "pause"),
+        SpacePair("to2", "tc3", ("operator", "cobot"), "pause"),
+    )
 
 
 def test_a_space_constraint_that_interrupts_slow_gives_mode_slow() -> None:
@@ -427,26 +430,24 @@ def test_a_space_constraint_that_interrupts_slow_gives_mode_slow() -> None:
 
     net = CaseNet(read_pattern(data))
 
-    assert [(p.cobot_task, p.mode) for p in net.space_pairs] == [("tc1", "pause"), ("tc3", "slow")]
+    assert [(p.second, p.mode) for p in net.space_pairs] == [("to1", "pause"), ("tc3", "slow")]
 
 
 def test_the_polishing_example_pairs_the_operator_with_the_cobot_on_each_side() -> None:
     net = _example_net("coop_1o1c_polishing")
 
-    assert {(p.operator_task, p.cobot_task) for p in net.space_pairs} == {
-        ("to1", "tc1"),
-        ("to1", "tc2"),
-        ("to2", "tc2"),
-        ("to2", "tc3"),
+    assert {frozenset((p.first, p.second)) for p in net.space_pairs} == {
+        frozenset(pair) for pair in (("to1", "tc1"), ("to1", "tc2"), ("to2", "tc2"), ("to2", "tc3"))
     }
 
 
-def test_a_space_constraint_between_two_operators_gives_no_pair() -> None:
+def test_a_space_constraint_between_two_operators_gives_a_pair_of_operators() -> None:
     net = _example_net("coop_2o2c_quality_inspection")
 
-    assert {(p.operator_task, p.cobot_task) for p in net.space_pairs} == {
-        ("to11", "tc12"),
-        ("to22", "tc21"),
+    assert {(p.first, p.second, p.kinds, p.mode) for p in net.space_pairs} == {
+        ("tc12", "to11", ("cobot", "operator"), "pause"),
+        ("to12", "to21", ("operator", "operator"), "wait"),
+        ("to22", "tc21", ("operator", "cobot"), "pause"),
     }
 
 

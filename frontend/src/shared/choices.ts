@@ -33,6 +33,7 @@ export const EVENT_TYPES: Record<string, string> = {
   "task-withdrawn": "Task withdrawn",
   "task-interrupted": "Task interrupted",
   "task-resumed": "Task resumed",
+  "task-kept-out": "Task kept out of a shared area",
   "transition-fired": "Transition fired",
   "message-sent": "Message sent",
   "message-received": "Message received",

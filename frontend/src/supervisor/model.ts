@@ -139,7 +139,7 @@ export function unseenEvents(lastSeq: number, events: readonly EventJson[]): Eve
 
 /** Whether these events change what the interruptions table shows. */
 export function touchesInterruptions(events: readonly EventJson[]): boolean {
-  return events.some((e) => e.type === "task-interrupted" || e.type === "task-resumed");
+  return events.some((e) => ["task-interrupted", "task-resumed", "task-kept-out"].includes(e.type));
 }
 
 export interface WorkRow {

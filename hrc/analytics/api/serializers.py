@@ -169,9 +169,15 @@ class ArrowSerializer(serializers.Serializer[Any]):
 
 class MarkSerializer(serializers.Serializer[Any]):
     interruption = serializers.IntegerField()
-    work_item = serializers.IntegerField(help_text="The cobot's task that was interrupted.")
-    operator_work_item = serializers.IntegerField(help_text="The operator's task that caused it.")
-    cobot = serializers.CharField()
+    work_item = serializers.IntegerField(help_text="The task held: paused, slowed or kept out.")
+    actor = serializers.CharField(help_text="The held task's pattern actor.")
+    by_work_item = serializers.IntegerField(help_text="The task in the shared area.")
+    by_task = serializers.CharField()
+    by_label = serializers.CharField()
+    by_actor = serializers.CharField(help_text="The pattern actor in the shared area.")
+    cobot = serializers.CharField(
+        allow_null=True, help_text="The held cobot; null for an operator."
+    )
     mode = serializers.CharField()
     started_at = serializers.DateTimeField()
     ended_at = serializers.DateTimeField(allow_null=True)

@@ -384,17 +384,28 @@ class CaseEventSerializer(serializers.ModelSerializer[CaseEvent]):
 
 
 class InterruptionSerializer(serializers.ModelSerializer[Interruption]):
-    """A cobot task paused or slowed while an operator worked in the area they share."""
+    """A task held while another worked in the area they share (a space constraint): a cobot's
+    step paused or slowed, or a task kept out (a cobot's step waiting, an operator refused)."""
 
     task = serializers.CharField(source="work_item.task", read_only=True)
-    operator_task = serializers.CharField(source="operator_work_item.task", read_only=True)
-    cobot_name = serializers.CharField(source="cobot.name", read_only=True)
-    mode = EnumField(InterruptionMode)
-    seconds = serializers.SerializerMethodField(
-        help_text="How long the operator was in the area; null while they still are."
+    actor = serializers.CharField(
+        source="work_item.actor", read_only=True, help_text="The held task's pattern actor."
     )
+    by_work_item = serializers.IntegerField(
+        source="by_work_item_id", read_only=True, help_text="The task in the area."
+    )
+    by_task = serializers.CharField(source="by_work_item.task", read_only=True)
+    by_actor = serializers.CharField(
+        source="by_work_item.actor", read_only=True, help_text="The pattern actor in the area."
+    )
+    cobot_name = serializers.CharField(source="cobot.name", read_only=True, allow_null=True)
+    mode = EnumField(InterruptionMode)
+    seconds = serializers.FloatField(
+        read_only=True, allow_null=True,
+        help_text="How long the other task was in the area; null while it still is.",
+    )  # fmt: skip
     settled = serializers.BooleanField(
-        read_only=True, help_text="Over, and the cobot no longer paused by it."
+        read_only=True, help_text="Over, and the cobot no longer paused or slowed by it."
     )
 
     class Meta:
@@ -403,8 +414,10 @@ class InterruptionSerializer(serializers.ModelSerializer[Interruption]):
             "id",
             "work_item",
             "task",
-            "operator_work_item",
-            "operator_task",
+            "actor",
+            "by_work_item",
+            "by_task",
+            "by_actor",
             "cobot",
             "cobot_name",
             "mode",
@@ -417,11 +430,6 @@ class InterruptionSerializer(serializers.ModelSerializer[Interruption]):
             "error",
         ]
         read_only_fields = fields
-
-    def get_seconds(self, interruption: Interruption) -> float | None:
-        if interruption.ended_at is None:
-            return None
-        return round((interruption.ended_at - interruption.started_at).total_seconds(), 3)
 
 
 class ActorMappingSerializer(serializers.Serializer[PatternVersion]):

@@ -96,7 +96,7 @@ def test_a_shared_space_marks_the_interruption_on_the_cobots_bar(
     assert arrow["overlapping"] is True  # both ran at once: the moment the cobot was paused
     assert arrow["from_at"] == arrow["to_at"] == "2025-03-01T08:00:10Z"
     (mark,) = body["marks"]
-    assert (mark["interruption"], mark["work_item"], mark["operator_work_item"]) == (
+    assert (mark["interruption"], mark["work_item"], mark["by_work_item"]) == (
         interruption.pk,
         items["tc1"],
         items["to2"],

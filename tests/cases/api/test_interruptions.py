@@ -22,7 +22,7 @@ def interruptions(step_case: Case, cobot: Cobot) -> list[Interruption]:
     began = timezone.now() - dt.timedelta(seconds=75)
     made = [
         Interruption.objects.create(
-            case=step_case, work_item=step, operator_work_item=operator_item, cobot=cobot, mode=mode
+            case=step_case, work_item=step, by_work_item=operator_item, cobot=cobot, mode=mode
         )
         for mode in (InterruptionMode.PAUSE, InterruptionMode.SLOW)
     ]
@@ -42,7 +42,8 @@ def test_a_member_reads_the_interruptions_in_order_with_their_durations(
     rows = response.data["results"]
     assert [row["id"] for row in rows] == [i.pk for i in interruptions]
     over, ongoing = rows
-    assert (over["task"], over["operator_task"], over["cobot_name"]) == ("tc1", "to1", cobot.name)
+    assert (over["task"], over["by_task"], over["cobot_name"]) == ("tc1", "to1", cobot.name)
+    assert (over["actor"], over["by_actor"]) == ("c", "o")  # both pattern actors
     assert (over["mode"], over["seconds"], over["settled"]) == ("pause", 12.5, True)
     assert (ongoing["mode"], ongoing["seconds"], ongoing["settled"]) == ("slow", None, False)
 

@@ -107,8 +107,10 @@ async def test_the_file_is_replaced_whole_and_holds_the_execution_record(tmp_pat
                 break
             await asyncio.sleep(0.01)
         assert json.loads(state.read_text())["runner"]["phase"] == "waiting"
-        # No temporary left behind.
-        assert sorted(p.name for p in tmp_path.iterdir()) == ["cobot1.json", "cobot1.json.journal"]
+        # No temporary left behind; the step log beside them (test_step_log.py).
+        assert sorted(p.name for p in tmp_path.iterdir()) == [
+            "cobot1.json", "cobot1.json.journal", "cobot1.json.steps",
+        ]  # fmt: skip
     finally:
         await cell.close()
 
