@@ -61,6 +61,12 @@ MIRRORS: list[tuple[str, str, Callable[[typing.Any], object], object]] = [
     ("editor/model/taskconfig.ts", "INTERRUPT_MODES", list, list(taskconfig.INTERRUPT_MODES)),
     (
         "editor/model/taskconfig.ts",
+        "SPACE_MODES",
+        dict,
+        {"+".join(pair): list(modes) for pair, modes in taskconfig.SPACE_MODES.items()},
+    ),
+    (
+        "editor/model/taskconfig.ts",
         "DEVICE_CALLS",
         dict,
         {name: list(arguments) for name, (_, arguments, _) in taskconfig.DEVICE_CALLS.items()},

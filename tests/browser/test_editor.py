@@ -766,6 +766,47 @@ def test_a_constraint_shows_its_task_names_and_reverses_with_undo(
     _save_and_expect_constraints(page, pattern, {("to1", "tc2"), ("tc3", "to2")})
 
 
+def test_a_space_constraint_offers_the_modes_of_its_pair_of_actors(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+) -> None:
+    page.set_viewport_size({"width": 1280, "height": 800})
+    document = json.loads((EXAMPLES / "coop_2o2c_quality_inspection.json").read_text())
+    pattern = factories.make_pattern(organisation, draft=document, name=document["name"])
+    sign_in(page, engineer)
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
+    panel = page.get_by_role("region", name="Properties")
+
+    def select_constraint(first: str, second: str) -> None:
+        (x1, y1), (x2, y2) = centre_of(page, first), centre_of(page, second)
+        page.mouse.click(x1 + (x2 - x1) / 2, y1 + (y2 - y1) / 2)
+        expect(panel.locator(".hrc-constraint-ends")).to_contain_text("(space)")
+
+    # Two operators: one way only, the second waits; nothing to choose but that.
+    select_constraint("to12", "to21")
+    operators = panel.get_by_label("When both operators need the shared area")
+    expect(operators.locator("option")).to_have_text(
+        ["the second waits (the tablet tells them why)"]
+    )
+    # A cobot and an operator: the cobot pauses (the default) or slows down.
+    select_constraint("tc12", "to11")
+    mixed = panel.get_by_label("While the operator is in the shared area, the cobot")
+    expect(mixed.locator("option")).to_have_text(["pauses", "slows down"])
+    mixed.select_option(label="slows down")
+    page.get_by_role("button", name="Save").click()
+
+    def saved() -> bool:
+        pattern.refresh_from_db()
+        modes = {(c["from"], c["to"]): c.get("interrupt") for c in pattern.draft["constraints"]}
+        return modes == {("tc12", "to11"): "slow", ("to12", "to21"): None, ("to22", "tc21"): None}
+
+    until(saved)
+
+
 def _save_and_expect_constraints(
     page: Page, pattern: PatternModel, expected: set[tuple[str, str]]
 ) -> None:

@@ -26,6 +26,30 @@ export const DEVICE_CALLS: Record<string, string[]> = {
 };
 /** How a space constraint's cobot makes way (its `interrupt` key), as the panel words it; pause is the default. */
 export const INTERRUPT_MODES: Record<string, string> = { pause: "pauses", slow: "slows down" };
+/** The `interrupt` modes a space constraint may have, by the kinds of its two actors (sorted,
+ * joined by "+"), the default first: the server's taskconfig.SPACE_MODES. */
+export const SPACE_MODES: Record<string, string[]> = {
+  "cobot+operator": ["pause", "slow"],
+  "cobot+cobot": ["wait", "pause"],
+  "operator+operator": ["wait"],
+};
+/** How the panel asks for a space constraint's mode, and words each mode, per pair of actor kinds. */
+export const SPACE_MODE_WORDS: Record<string, { question: string; modes: Record<string, string> }> = {
+  "cobot+operator": { question: "While the operator is in the shared area, the cobot", modes: INTERRUPT_MODES },
+  "cobot+cobot": {
+    question: "When both cobots need the shared area",
+    modes: { wait: "the later step waits for it", pause: "the running cobot pauses for the later step" },
+  },
+  "operator+operator": {
+    question: "When both operators need the shared area",
+    modes: { wait: "the second waits (the tablet tells them why)" },
+  },
+};
+
+/** The key of SPACE_MODES for two actor kinds, in either order. */
+export function actorPair(first: ActorType, second: ActorType): string {
+  return [first, second].sort().join("+");
+}
 export const POSE_LENGTH = 6;
 export const MAX_POSES = 2;
 export const FIELD_TYPES = ["string", "integer", "number", "boolean"] as const;

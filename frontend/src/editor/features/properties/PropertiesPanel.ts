@@ -9,8 +9,8 @@ import type EventBus from "diagram-js/lib/core/EventBus";
 import type Selection from "diagram-js/lib/features/selection/Selection";
 import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
-import { PATTERN_NAMES } from "../../model/document";
-import { INTERRUPT_MODES } from "../../model/taskconfig";
+import { PATTERN_NAMES, type ActorType } from "../../model/document";
+import { SPACE_MODES, SPACE_MODE_WORDS, actorPair } from "../../model/taskconfig";
 import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
@@ -139,9 +139,26 @@ export default class PropertiesPanel {
     const reverse = button(this.panel, "Reverse", () => this.modeling.reverseConstraint(connection));
     reverse.title = "Swap the two tasks: the constraint then runs the other way";
     select(this.panel, "Kind", object.data.type, CONSTRAINT_TYPES.map((type): [string, string] => [type, type]), (type) => this.modeling.updateData(connection, { type, interrupt: type === "space" ? object.data.interrupt : undefined }));
-    if (object.data.type === "space") {
-      select(this.panel, "While the operator is in the shared area, the cobot", String(object.data.interrupt ?? "pause"), Object.entries(INTERRUPT_MODES), (mode) => this.modeling.updateData(connection, { interrupt: mode === "pause" ? undefined : mode }));
-    }
+    if (object.data.type === "space") this.spaceModeSection(connection, object);
+  }
+
+  /** The space constraint's mode, offered as its pair of actors allows (cobot and operator, two
+   * cobots, two operators); the default is left unwritten. */
+  private spaceModeSection(connection: Connection, object: ConstraintObject): void {
+    const kinds = [connection.source, connection.target].map((task) => this.actorKind(task));
+    if (kinds[0] === undefined || kinds[1] === undefined) return;
+    const pair = actorPair(kinds[0], kinds[1]);
+    const [fallback, ...others] = SPACE_MODES[pair];
+    const words = SPACE_MODE_WORDS[pair];
+    const choices = [fallback, ...others].map((mode): [string, string] => [mode, words.modes[mode]]);
+    select(this.panel, words.question, String(object.data.interrupt ?? fallback), choices, (mode) => this.modeling.updateData(connection, { interrupt: mode === fallback ? undefined : mode }));
+  }
+
+  /** The kind of actor whose lane the task is in; undefined for a split/join. */
+  private actorKind(task: Connection["source"]): ActorType | undefined {
+    const performer = (objectOf(task) as { data?: { performer?: string } } | undefined)?.data?.performer;
+    const lane = performer ? this.elementRegistry.get(performer) : undefined;
+    return lane && isLane(lane) ? laneObject(lane).data.type : undefined;
   }
 
   private arcSection(connection: Connection): void {
