@@ -653,6 +653,43 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
     expect(pattern_badge(page)).to_have_attribute("data-valid", "true", timeout=CHECKED)
 
 
+def test_messages_a_transition_waits_for_and_a_task_sends_are_edited_as_json(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+) -> None:
+    pattern = _assembly(organisation)
+    sign_in(page, engineer)
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    panel = page.get_by_role("region", name="Properties")
+
+    def commit(label: str, value: str) -> None:
+        field = panel.get_by_label(label, exact=True)
+        field.fill(value)
+        field.press("Tab")
+
+    select_element(page, "t1")
+    expect(panel.get_by_role("heading", name="Silent transition")).to_be_visible()
+    commit("Waits for a message", '{"name": "part-ready"')
+    expect(panel.get_by_role("alert").filter(has_text="Not JSON")).to_be_visible()
+    commit("Waits for a message", '{"name": "part-ready", "correlation": {"order": "=data.order"}}')
+    select_element(page, "tc3")
+    commit("Sends a message when it completes", '{"name": "done", "payload": {"by": "cobot"}}')
+    page.get_by_role("button", name="Save").click()
+
+    def saved() -> bool:
+        pattern.refresh_from_db()
+        transitions = {t["id"]: t for t in pattern.draft["processes"][0]["transitions"]}
+        return transitions["t1"].get("message") == {
+            "name": "part-ready",
+            "correlation": {"order": "=data.order"},
+        } and transitions["tc3"].get("send") == {"name": "done", "payload": {"by": "cobot"}}
+
+    until(saved)
+
+
 def test_keys_select_copy_paste_delete_and_undo(
     page: Page, live_url: str, engineer: User, organisation: Organisation, sign_in: SignIn
 ) -> None:

@@ -15,6 +15,8 @@ import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
 import { quotedName } from "../../model/words";
+
+const MESSAGE_EXAMPLE = '{"name": "sync1", "correlation": {"case": "=case.id"}, "payload": {"cycle": "=data.cycle"}}';
 import { isLane, lanesTopDown, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
@@ -96,6 +98,8 @@ export default class PropertiesPanel {
     }
     if (silent) {
       field(this.panel, { label: "Guard", value: String(object.data.guard ?? ""), hint: "Fires only when this expression over data holds, e.g. data.count > 3", commit: (text) => this.modeling.updateData(shape, { guard: text.trim() || undefined }) });
+      this.messageField(shape, "message", "Waits for a message", '{"name": "sync1", "correlation": {"case": "=case.id"}}');
+      this.messageField(shape, "send", "Sends a message when it fires", MESSAGE_EXAMPLE);
       return;
     }
     const performer = String(object.data.performer ?? "");
@@ -109,6 +113,28 @@ export default class PropertiesPanel {
     });
     const actor = this.elementRegistry.get(performer);
     taskSection(this.panel, shape, actor && isLane(actor) ? laneObject(actor).data.type : undefined, this.modeling, this.deviceCalls);
+    this.messageField(shape, "send", "Sends a message when it completes", MESSAGE_EXAMPLE);
+  }
+
+  /** A message key (`message` or `send`) as JSON text: its name, correlation and payload are
+   * checked by the server's check, which names what is wrong; here only that it is an object. */
+  private messageField(shape: Shape, key: "message" | "send", label: string, example: string): void {
+    const object = objectOf(shape) as { data?: Record<string, unknown> } | undefined;
+    const value = object?.data?.[key];
+    field(this.panel, { label, value: value === undefined ? "" : JSON.stringify(value), hint: `JSON, e.g. ${example}`, commit: (text) => {
+      if (!text.trim()) {
+        this.modeling.updateData(shape, { [key]: undefined });
+        return;
+      }
+      let parsed: unknown;
+      try {
+        parsed = JSON.parse(text);
+      } catch {
+        throw new Error("Not JSON: write an object such as the example.");
+      }
+      if (typeof parsed !== "object" || parsed === null || Array.isArray(parsed)) throw new Error("Write an object with a \"name\", such as the example.");
+      this.modeling.updateData(shape, { [key]: parsed });
+    } });
   }
 
   private laneSection(shape: Shape): void {
