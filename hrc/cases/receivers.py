@@ -1,6 +1,7 @@
 """The cases app's answers to the inner apps' hooks, registered when Django is ready (apps.py)."""
 
 from hrc.cases import (
+    device_jobs,
     interruptions,
     selectors,
     services,
@@ -18,5 +19,6 @@ cobot_hooks.register_cobot_queues(
     held_by_interruption=interruptions.holds_cobot,
     queue_released=interruptions.ring_next_job_on_commit,
 )
+cobot_hooks.register_device_queues(devices_released=device_jobs.ring_devices_on_commit)
 # A deactivated person's tasks go back to their candidates.
 organisation_hooks.register_member_leaving(services.hand_back_work_items)

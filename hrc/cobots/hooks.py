@@ -26,6 +26,8 @@ QueueLengths = Callable[[Collection[int]], dict[int, int]]
 HeldByInterruption = Callable[[int], bool]
 # The cobot's queue may go on (a STOP ended): start its next job after commit, if one waits.
 QueueReleased = Callable[[int], None]
+# The devices' queues may go on (their cell's STOP ended): start their next calls after commit.
+DevicesReleased = Callable[[Collection[int]], None]
 # Tell the tablets after commit: the cobot's queue changed / a STOP began, changed or ended.
 QueueChanged = Callable[[int], None]
 StopChanged = Callable[[CellStop], None]
@@ -39,6 +41,7 @@ class _CobotUse:
     queue_released: QueueReleased | None = None
     queue_changed: QueueChanged | None = None
     stop_changed: StopChanged | None = None
+    devices_released: DevicesReleased | None = None
 
 
 _REGISTERED = _CobotUse()
@@ -74,6 +77,18 @@ def register_cobot_queues(
     """Called once by the app that runs cases, from its receivers."""
     _REGISTERED.held_by_interruption = held_by_interruption
     _REGISTERED.queue_released = queue_released
+
+
+def register_device_queues(*, devices_released: DevicesReleased) -> None:
+    """Called once by the app that runs cases, from its receivers."""
+    _REGISTERED.devices_released = devices_released
+
+
+def devices_released(device_ids: Collection[int]) -> None:
+    """Starts the devices' next queued calls once the transaction commits, if any wait."""
+    if _REGISTERED.devices_released is None:
+        raise ImproperlyConfigured("No app has registered devices_released (hrc.cases does).")
+    _REGISTERED.devices_released(device_ids)
 
 
 def register_tablets(*, queue_changed: QueueChanged, stop_changed: StopChanged) -> None:
