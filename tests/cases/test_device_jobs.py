@@ -1,0 +1,237 @@
+"""Devices with queues of their own (simulated gateways, this process's threads as workers):
+a device call and a cobot step of one cell run at the same time, a device's calls one at a
+time, a failed call is an incident on the device's work item, and a case never starts with a
+device call nobody can serve."""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from hrc.cases import services
+from hrc.cases.choices import CaseStatus, IncidentKind, JobState
+from hrc.cases.models import Case, Incident, Job
+from hrc.cases.simulation import Simulation
+from hrc.cobots import services as cobot_services
+from hrc.errors import Invalid
+from hrc.organisations.choices import Role
+from tests.cases.patterns import PICK, PROGRAM, scan_until_found
+from tests.factories import make_cobot, make_member, make_organisation, make_version
+from tests.support.polling import until
+
+AXIS = {"id": "axis", "type": "cobot", "device": "linear-axis"}
+
+
+def _axis_beside_a_pick(direction: str = "right", axis_ms: int = 2000) -> dict[str, Any]:
+    """The cobot picks (a 2 s tool wait) while the linear axis moves: nothing orders them."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "split"},
+        {"id": "tc_pick", "performer": "c", "label": "pick", "task": {
+            "step": {"number": PICK}, "timeout": 30}},
+        {"id": "ta_move", "performer": "axis", "label": "move the axis", "task": {
+            "device": {"call": "linear-axis.move",
+                       "args": {"direction": direction, "duration_ms": axis_ms}},
+            "timeout": 30, "retries": 0}},
+        {"id": "join"},
+    ]  # fmt: skip
+    arcs = [
+        ["p0", "split"], ["split", "p1"], ["split", "p2"], ["p1", "tc_pick"], ["tc_pick", "p3"],
+        ["p2", "ta_move"], ["ta_move", "p4"], ["p3", "join"], ["p4", "join"], ["join", "p5"],
+    ]  # fmt: skip
+    return {
+        "format": "hrc-pattern/1",
+        "name": "Axis beside a pick",
+        "actors": [{"id": "c", "type": "cobot", "program": PROGRAM}, AXIS],
+        "processes": [{
+            "id": "N", "workpiece": "w", "actors": ["c", "axis"],
+            "places": [{"id": f"p{i}", "tokens": int(i == 0)} for i in range(6)],
+            "transitions": tasks, "arcs": arcs,
+        }],
+        "constraints": [],
+    }  # fmt: skip
+
+
+def _interval(job: Job) -> tuple[dt.datetime, dt.datetime]:
+    assert job.accepted_at is not None
+    assert job.ended_at is not None
+    return job.accepted_at, job.ended_at
+
+
+@pytest.fixture
+def simulation(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Simulation]:
+    document, time_scale = request.param
+    with Simulation(document, tmp_path, time_scale=time_scale) as running:
+        yield running
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("simulation", [(_axis_beside_a_pick(), 1.0)], indirect=True)
+def test_a_device_call_and_a_cobot_step_of_one_cell_run_at_the_same_time(
+    simulation: Simulation,
+) -> None:
+    with simulation.running(operators=False):
+        [case_id] = simulation.start_cases(1)
+        assert simulation.wait([case_id], timeout=60)
+    case = Case.objects.get(pk=case_id)
+    assert case.status == CaseStatus.COMPLETED
+
+    move = Job.objects.get(case=case, work_item__task="ta_move")
+    pick = Job.objects.get(case=case, work_item__task="tc_pick")
+    assert move.device is not None
+    assert move.cobot_id is None
+    assert move.device.kind == "linear-axis"
+    assert move.work_item.device_id == move.device_id
+    assert pick.cobot_id is not None
+    assert pick.device_id is None
+    move_from, move_to = _interval(move)
+    pick_from, pick_to = _interval(pick)
+    # Both take about 2 s; one after the other they would not overlap at all.
+    overlap = (min(move_to, pick_to) - max(move_from, pick_from)).total_seconds()
+    assert overlap > 1.0, (move_from, move_to, pick_from, pick_to)
+    assert simulation.cobot("c").read("Devices/LinearAxis/Position") == "right"
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("simulation", [(_axis_beside_a_pick(axis_ms=1000), 0.5)], indirect=True)
+def test_a_devices_calls_run_one_at_a_time_first_come_first_served(
+    simulation: Simulation,
+) -> None:
+    with simulation.running(operators=False):
+        started = simulation.start_cases(3)
+        assert simulation.wait(started, timeout=60)
+    moves = list(Job.objects.filter(case_id__in=started, work_item__task="ta_move"))
+    assert len({job.device_id for job in moves}) == 1
+    assert all(job.state == JobState.SUCCEEDED for job in moves)
+    intervals = sorted(_interval(job) for job in moves)
+    for (_, ended), (began, _) in itertools.pairwise(intervals):
+        assert began >= ended  # never two moves of one axis at once
+    by_queue = sorted(moves, key=lambda job: (job.queued_at, job.pk))
+    assert [job.pk for job in by_queue] == [
+        job.pk for job in sorted(moves, key=lambda job: _interval(job)[0])
+    ]
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize(
+    "simulation", [(_axis_beside_a_pick(direction="up", axis_ms=100), 0.0)], indirect=True
+)
+def test_a_failed_device_call_opens_an_incident_on_its_item_naming_the_device(
+    simulation: Simulation,
+) -> None:
+    with simulation.running(operators=False):
+        [case_id] = simulation.start_cases(1)
+        incident = until(lambda: Incident.objects.filter(case_id=case_id).first(), timeout=30)
+        # The cobot's own step is not held up by the device's failure.
+        until(
+            lambda: Job.objects.filter(
+                case_id=case_id, work_item__task="tc_pick", state=JobState.SUCCEEDED
+            ).exists(),
+            timeout=30,
+        )
+    move = Job.objects.get(case_id=case_id, work_item__task="ta_move")
+    assert move.state == JobState.FAILED
+    assert incident.kind == IncidentKind.DEVICE_FAILED
+    assert incident.work_item_id == move.work_item_id
+    assert move.device is not None
+    assert f"Device {move.device.name}" in incident.message
+    assert "direction must be 'left' or 'right'" in incident.message
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("simulation", [(scan_until_found(), 0.0)], indirect=True)
+def test_a_call_in_a_cobots_lane_runs_on_the_device_of_its_cell(simulation: Simulation) -> None:
+    with simulation.running():
+        [case_id] = simulation.start_cases(1)
+        assert simulation.wait([case_id], timeout=60)
+    calls = Job.objects.filter(case_id=case_id, work_item__task__in=["tc_scan", "tc_show"])
+    assert calls.exists()
+    for job in calls:
+        assert job.cobot_id is None
+        assert job.device is not None
+        assert job.device.cell == job.device.gateway.cell == "c"
+
+
+# Resolution at the start (no workers) --------------------------------------------------------
+
+
+@pytest.mark.django_db
+def test_a_case_start_refuses_a_call_no_device_of_the_cobots_cell_serves() -> None:
+    organisation = make_organisation()
+    engineer = make_member(organisation, Role.ENGINEER)
+    operator = make_member(organisation, Role.OPERATOR)
+    cobot = make_cobot(organisation, cell="cell-a")
+    version = make_version(organisation, published_by=engineer, draft=scan_until_found())
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}}
+
+    with pytest.raises(Invalid) as refused:
+        services.start_case(version, started_by=engineer, actor_mapping=mapping)
+    assert list(refused.value.fields) == ["actor_mapping.c"]
+    message = str(refused.value)
+    assert cobot.name in message
+    assert "cell cell-a" in message
+    assert "display" in message
+    assert not Case.objects.exists()
+
+    # A detector in another cell serves nobody here; one in the cell does.
+    other = make_cobot(organisation, cell="cell-b")
+    for kind in ("part-detection", "display"):
+        cobot_services.create_device(
+            organisation, name=f"{kind}-b", kind=kind, cell="cell-b", gateway=other
+        )
+    with pytest.raises(Invalid):
+        services.start_case(version, started_by=engineer, actor_mapping=mapping)
+    for kind in ("part-detection", "display"):
+        cobot_services.create_device(
+            organisation, name=f"{kind}-a", kind=kind, cell="cell-a", gateway=cobot
+        )
+    case = services.start_case(version, started_by=engineer, actor_mapping=mapping)
+    devices = case.actor_mapping["c"]["devices"]
+    assert set(devices) == {"part-detection", "display"}
+
+
+@pytest.mark.django_db
+def test_a_device_actor_maps_to_the_only_device_of_its_kind_or_must_be_named() -> None:
+    organisation = make_organisation()
+    engineer = make_member(organisation, Role.ENGINEER)
+    cobot = make_cobot(organisation, cell="cell-a")
+    version = make_version(organisation, published_by=engineer, draft=_axis_beside_a_pick())
+
+    with pytest.raises(Invalid) as refused:
+        services.start_case(version, started_by=engineer, actor_mapping={"c": {"cobot": cobot.pk}})
+    assert list(refused.value.fields) == ["actor_mapping.axis"]
+    assert "linear-axis" in str(refused.value)
+    assert "none" in str(refused.value)
+
+    axis = cobot_services.create_device(
+        organisation, name="axis1", kind="linear-axis", cell="cell-a", gateway=cobot
+    )
+    case = services.start_case(
+        version, started_by=engineer, actor_mapping={"c": {"cobot": cobot.pk}}
+    )
+    assert case.actor_mapping["axis"] == {"device": axis.pk}
+
+    cobot_services.create_device(
+        organisation, name="axis2", kind="linear-axis", cell="cell-a", gateway=cobot
+    )
+    with pytest.raises(Invalid) as refused:
+        services.start_case(version, started_by=engineer, actor_mapping={"c": {"cobot": cobot.pk}})
+    assert "several" in str(refused.value)
+    mapping = {"c": {"cobot": cobot.pk}, "axis": {"device": "axis2"}}
+    case = services.start_case(version, started_by=engineer, actor_mapping=mapping)
+    assert case.actor_mapping["axis"]["device"] != axis.pk
+
+    # Another organisation's axis is no one's to map.
+    outsider = make_organisation()
+    theirs = cobot_services.create_device(
+        outsider, name="axis9", kind="linear-axis", gateway=make_cobot(outsider)
+    )
+    with pytest.raises(Invalid):
+        services.start_case(
+            version, started_by=engineer,
+            actor_mapping={"c": {"cobot": cobot.pk}, "axis": {"device": theirs.pk}},
+        )  # fmt: skip
