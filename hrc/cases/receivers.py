@@ -19,6 +19,9 @@ cobot_hooks.register_cobot_queues(
     held_by_interruption=interruptions.holds_cobot,
     queue_released=interruptions.ring_next_job_on_commit,
 )
-cobot_hooks.register_device_queues(devices_released=device_jobs.ring_devices_on_commit)
+# A device's queue: rung when its cell's STOP ends, shown on the cobot and device pages.
+cobot_hooks.register_device_queues(
+    devices_released=device_jobs.ring_devices_on_commit, device_queues=selectors.device_queues
+)
 # A deactivated person's tasks go back to their candidates.
 organisation_hooks.register_member_leaving(services.hand_back_work_items)

@@ -7,6 +7,8 @@ reach another's robot by its address or its credentials. CellStop records
 each STOP a tablet gave (hrc.cobots.stops).
 """
 
+from collections.abc import Collection
+
 from django.conf import settings
 from django.core.exceptions import ValidationError
 from django.db import models
@@ -381,6 +383,13 @@ class Device(models.Model):
 
     def __str__(self) -> str:
         return self.name
+
+    def validate_constraints(self, exclude: Collection[str] | None = None) -> None:
+        # Its one constraint is about the name: said at the name's field, not above the form.
+        try:
+            super().validate_constraints(exclude=exclude)
+        except ValidationError as error:
+            raise ValidationError({"name": error.messages}) from None
 
     def clean(self) -> None:
         """The gateway is a cobot of the device's own organisation: no calls through another's."""

@@ -162,8 +162,8 @@ def test_extended_spot_taping_shares_the_cobots_between_two_operators_one_step_a
         assert (case.data["cycle"], case.data["harnesses"]) == (2, 4)
     # Operator 2's case: its own operator, the cobots swapped.
     assert first.actor_mapping["o"] != second.actor_mapping["o"]
-    assert first.actor_mapping["cL"] == second.actor_mapping["cR"]
-    assert first.actor_mapping["cR"] == second.actor_mapping["cL"]
+    assert first.actor_mapping["cL"]["cobot"] == second.actor_mapping["cR"]["cobot"]
+    assert first.actor_mapping["cR"]["cobot"] == second.actor_mapping["cL"]["cobot"]
     assert run.executions == {"cL": 8, "cR": 8}  # four spots for each operator on each cobot
     # Each operator's axis is their own left cobot's cell's.
     assert run.devices["cL"]["LinearAxis/Position"] == run.devices["cR"]["LinearAxis/Position"]
