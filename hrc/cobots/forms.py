@@ -42,12 +42,7 @@ class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs make
         return name
 
     def add_service_errors(self, error: ValidationError) -> None:
-        """Puts a service's refusal at its field (or above the form when it names none)."""
-        if hasattr(error, "error_dict"):
-            for field, messages in error.message_dict.items():
-                self.add_error(field if field in self.fields else None, messages)
-        else:
-            self.add_error(None, error.messages)
+        add_service_errors(self, error)
 
 
 class CredentialsSecretForm(forms.Form):
@@ -105,4 +100,14 @@ class DeviceForm(forms.ModelForm):  # type: ignore[type-arg]  # as CobotForm
             raise ValidationError(f"The organisation already has a device named {name}.")
         return name
 
-    add_service_errors = CobotForm.add_service_errors
+    def add_service_errors(self, error: ValidationError) -> None:
+        add_service_errors(self, error)
+
+
+def add_service_errors(form: forms.BaseForm, error: ValidationError) -> None:
+    """Puts a service's refusal at its field (or above the form when it names none)."""
+    if hasattr(error, "error_dict"):
+        for field, messages in error.message_dict.items():
+            form.add_error(field if field in form.fields else None, messages)
+    else:
+        form.add_error(None, error.messages)
