@@ -103,8 +103,12 @@ def _write(simulation: Simulation, cobot: str, values: dict[str, str]) -> None:
 
 
 def _cobot_jobs(cases: list[Case]) -> Iterator[tuple[int, list[Job]]]:
-    """Each cobot's jobs of these cases (steps and device calls), in the order they ran."""
-    jobs = Job.objects.filter(case__in=cases).select_related("work_item").order_by("started_at")
+    """Each cobot's jobs of these cases, in the order they ran (device calls are their devices')."""
+    jobs = (
+        Job.objects.filter(case__in=cases, cobot__isnull=False)
+        .select_related("work_item")
+        .order_by("started_at")
+    )
     for cobot in sorted({job.cobot_id for job in jobs}):
         yield cobot, [job for job in jobs if job.cobot_id == cobot]
 
@@ -147,6 +151,10 @@ def test_spot_taping_tapes_four_harnesses_in_two_cycles_the_pedal_moving_the_axi
     assert pedals == moves == 9
     assert run.devices["cL"]["LinearAxis/Position"] == "left"
     assert run.devices["cR"]["LinearAxis/Position"] == "left"  # the right cell's axis: unused
+    # The axis is a device actor of its own lane: its moves wait in its queue, not a cobot's.
+    axis_moves = Job.objects.filter(case=case, work_item__task__startswith="tc_axis")
+    assert {(job.device.kind if job.device else None) for job in axis_moves} == {"linear-axis"}
+    assert not axis_moves.filter(cobot__isnull=False).exists()
 
 
 @pytest.mark.django_db(transaction=True)
@@ -181,8 +189,8 @@ def test_extended_spot_taping_shares_the_cobots_between_two_operators_one_step_a
     served: dict[int, list[int]] = {}
     for event in run.trace:
         cobot = cobot_of.get((event["case"], event["actor"]))
-        if cobot is None:
-            continue
+        if cobot is None or event["task"].startswith("tc_axis"):
+            continue  # an axis move runs in the axis's own queue, beside the cobot's steps
         if event["event"] == "task-started":
             assert running.get(cobot) is None, f"two tasks at once on cobot {cobot}: {event}"
             running[cobot] = (event["case"], event["task"])
