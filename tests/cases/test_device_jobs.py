@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -18,6 +19,8 @@ from hrc.cases.choices import CaseStatus, IncidentKind, JobState
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
 from hrc.cobots import services as cobot_services
+from hrc.cobots import stops
+from hrc.cobots.models import Device
 from hrc.errors import Invalid
 from hrc.organisations.choices import Role
 from tests.cases.patterns import PICK, PROGRAM, scan_until_found
@@ -235,3 +238,48 @@ def test_a_device_actor_maps_to_the_only_device_of_its_kind_or_must_be_named() -
             version, started_by=engineer,
             actor_mapping={"c": {"cobot": cobot.pk}, "axis": {"device": theirs.pk}},
         )  # fmt: skip
+
+
+def _axis_alone(axis_ms: int = 100) -> dict[str, Any]:
+    """The axis moves once: a device actor's lane, no cobot's."""
+    move = {
+        "device": {
+            "call": "linear-axis.move",
+            "args": {"direction": "right", "duration_ms": axis_ms},
+        },
+        "timeout": 30,
+    }
+    return {
+        "format": "hrc-pattern/1",
+        "name": "Axis alone",
+        "actors": [AXIS],
+        "processes": [{
+            "id": "N", "workpiece": "w", "actors": ["axis"],
+            "places": [{"id": "p0", "tokens": 1}, {"id": "p1", "tokens": 0}],
+            "transitions": [{"id": "ta_move", "performer": "axis", "label": "move", "task": move}],
+            "arcs": [["p0", "ta_move"], ["ta_move", "p1"]],
+        }],
+        "constraints": [],
+    }  # fmt: skip
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("simulation", [(_axis_alone(), 0.0)], indirect=True)
+def test_a_stop_of_the_cell_holds_its_devices_calls_until_it_is_resumed(
+    simulation: Simulation,
+) -> None:
+    person = make_member(simulation.organisation, Role.OPERATOR)
+    device = Device.objects.get(organisation=simulation.organisation, kind="linear-axis")
+    stops.stop_cell(simulation.organisation, device.cell, by=person)
+    with simulation.running(operators=False):
+        [case_id] = simulation.start_cases(1)
+        time.sleep(1.5)  # the sweeper rings the queue every 0.5 s: nothing may start
+        move = Job.objects.get(case_id=case_id)
+        assert move.state == JobState.QUEUED
+        assert move.sent_at is None
+        stops.resume_cell(simulation.organisation, device.cell, by=person, confirmed=True)
+        assert simulation.wait([case_id], timeout=30)
+    move.refresh_from_db()
+    assert move.state == JobState.SUCCEEDED
+    assert Case.objects.get(pk=case_id).status == CaseStatus.COMPLETED
+    assert simulation.cobot("axis").read("Devices/LinearAxis/Position") == "right"
