@@ -143,12 +143,13 @@ def jobs_visible_to(user: AnyUser) -> QuerySet[Job]:
 
 
 def cobot_queues(user: AnyUser) -> QuerySet[Job]:
-    """Queued and running jobs in queue order: per cobot, the running one, then first come first served."""
+    """Queued and running jobs in queue order: per cobot, then per device, the running one, then
+    first come first served."""
     running_first = SqlCase(When(state=JobState.RUNNING, then=Value(0)), default=Value(1))
     return (
         jobs_visible_to(user)
         .filter(state__in=QUEUE_STATES)
-        .order_by("cobot_id", running_first, "queued_at", "id")
+        .order_by("cobot_id", "device_id", running_first, "queued_at", "id")
     )
 
 

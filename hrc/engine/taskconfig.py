@@ -21,6 +21,10 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
 - `"message"` on a silent transition: `{"name": "...", "correlation": {"key": "expression"}}`;
   it fires when a matching message arrives (POST /api/messages/), never by itself.
 
+An actor may carry `"device": "<kind>"` (a cobot actor only): a device actor, whose lane holds
+device calls of that kind only (a linear axis beside the cobots); DEVICE_KINDS are the calls'
+prefixes.
+
 And the document itself may carry `"data"`: a JSON object every case's data
 starts with (the use case's settings: poses, spots, task lists); the data a
 case is started with is laid over it, key by key.
