@@ -84,7 +84,13 @@ def lease_next_device_job(which: Q) -> jobs.Lease | None:
             .filter(which)
             .first()
         )
-        if device is None or not device.is_active or cell_stopped(device):
+        if device is None:
+            return None
+        held = _why_held(device)
+        if held:
+            # Said on each queued call, so that the supervisor sees why nothing moves.
+            queued = Job.objects.filter(device=device, state=JobState.QUEUED)
+            queued.exclude(waiting_for=held).update(waiting_for=held)
             return None
         queued = (
             Job.objects.filter(
@@ -101,6 +107,15 @@ def lease_next_device_job(which: Q) -> jobs.Lease | None:
             if lease is not None:
                 return lease
     return None
+
+
+def _why_held(device: Device) -> str:
+    """Why none of the device's calls may start now; "" when they may."""
+    if not device.is_active:
+        return f"device {device.name} to be put back in service"
+    if cell_stopped(device):
+        return f"cell {device.cell} to be resumed after its STOP"
+    return ""
 
 
 def cell_stopped(device: Device) -> bool:

@@ -459,6 +459,9 @@ def retry_job(case: Case, net: CaseNet, item: WorkItem, again: bool) -> None:
         0,
     )
     job.next_try_at, job.last_error = timezone.now(), ""
+    # A person checked the device and asks for the call: it goes out once more. (By itself,
+    # a call that may have gone out is never sent again: device_jobs, jobs._call_device.)
+    job.sent_at = None
     if again:
         job.attempt += 1
     job.save()

@@ -13,8 +13,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from django.db.models import Q
+from django.utils import timezone
 
-from hrc.cases import services
+from hrc.cases import device_jobs, jobs, services
 from hrc.cases.choices import CaseStatus, IncidentKind, JobState
 from hrc.cases.models import Case, Incident, Job
 from hrc.cases.simulation import Simulation
@@ -277,9 +279,76 @@ def test_a_stop_of_the_cell_holds_its_devices_calls_until_it_is_resumed(
         move = Job.objects.get(case_id=case_id)
         assert move.state == JobState.QUEUED
         assert move.sent_at is None
+        assert move.waiting_for == f"cell {device.cell} to be resumed after its STOP"
         stops.resume_cell(simulation.organisation, device.cell, by=person, confirmed=True)
         assert simulation.wait([case_id], timeout=30)
     move.refresh_from_db()
     assert move.state == JobState.SUCCEEDED
     assert Case.objects.get(pk=case_id).status == CaseStatus.COMPLETED
     assert simulation.cobot("axis").read("Devices/LinearAxis/Position") == "right"
+
+
+# The device's queue, leased by hand (no workers, nothing reaches a gateway) ------------------
+
+
+@pytest.mark.django_db
+def test_a_devices_queue_leases_one_call_at_a_time_and_never_resends_a_lost_answer() -> None:
+    organisation = make_organisation()
+    admin = make_member(organisation, Role.ADMIN)
+    cobot = make_cobot(organisation, cell="cell-a")
+    axis = cobot_services.create_device(
+        organisation, name="axis1", kind="linear-axis", cell="cell-a", gateway=cobot
+    )
+    version = make_version(organisation, published_by=admin, draft=_axis_alone())
+    first = services.start_case(version, started_by=admin)
+    second = services.start_case(version, started_by=admin)
+    which = Q(pk=axis.pk)
+
+    lease = device_jobs.lease_next_device_job(which)
+    assert lease is not None
+    assert lease.case_id == first.pk  # first come, first served
+    assert lease.cobot == cobot  # through its gateway's cobot
+    assert device_jobs.lease_next_device_job(which) is None  # one call at a time
+    assert Job.objects.get(case=second).state == JobState.QUEUED
+
+    # The call went out, then the worker was lost: its lease expires, the call is queued again…
+    Job.objects.filter(pk=lease.job_id).update(
+        sent_at=timezone.now(), lease_expires_at=timezone.now() - dt.timedelta(seconds=1)
+    )
+    jobs.sweep()
+    assert Job.objects.get(pk=lease.job_id).state == JobState.QUEUED
+    # …and the next worker refuses to send it again: an incident on the device's item.
+    device_jobs.run_next_device_job(lease.job_id)
+    job = Job.objects.get(pk=lease.job_id)
+    assert job.state == JobState.FAILED
+    incident = Incident.objects.get(case=first)
+    assert incident.kind == IncidentKind.DEVICE_FAILED
+    assert incident.work_item_id == job.work_item_id
+    assert "Device axis1" in incident.message
+    assert "answer was lost" in incident.message
+
+    # A person checks the axis and retries: then, and only then, the call may go out again.
+    services.resolve_incident(incident, by=admin, resolution="retry")
+    job.refresh_from_db()
+    assert (job.state, job.sent_at) == (JobState.QUEUED, None)
+    again = device_jobs.lease_next_device_job(which)
+    assert again is not None
+    assert again.job_id == job.pk
+    assert not again.sent_before
+
+
+@pytest.mark.django_db
+def test_an_inactive_device_leases_nothing() -> None:
+    organisation = make_organisation()
+    admin = make_member(organisation, Role.ADMIN)
+    cobot = make_cobot(organisation)
+    axis = cobot_services.create_device(
+        organisation, name="axis1", kind="linear-axis", gateway=cobot
+    )
+    version = make_version(organisation, published_by=admin, draft=_axis_alone())
+    case = services.start_case(version, started_by=admin)
+    cobot_services.update_device(axis, is_active=False)
+    assert device_jobs.lease_next_device_job(Q(pk=axis.pk)) is None
+    job = Job.objects.get(case=case)
+    assert job.state == JobState.QUEUED
+    assert job.waiting_for == "device axis1 to be put back in service"
