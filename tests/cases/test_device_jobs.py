@@ -75,7 +75,7 @@ def simulation(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Simul
 
 
 @pytest.mark.django_db(transaction=True)
-@pytest.mark.parametrize("simulation", [(_axis_beside_a_pick(), 1.0)], indirect=True)
+@pytest.mark.parametrize("simulation", [(_axis_beside_a_pick(axis_ms=4000), 1.0)], indirect=True)
 def test_a_device_call_and_a_cobot_step_of_one_cell_run_at_the_same_time(
     simulation: Simulation,
 ) -> None:
@@ -95,7 +95,10 @@ def test_a_device_call_and_a_cobot_step_of_one_cell_run_at_the_same_time(
     assert pick.device_id is None
     move_from, move_to = _interval(move)
     pick_from, pick_to = _interval(pick)
-    # Both take about 2 s; one after the other they would not overlap at all.
+    # The move takes 4 s, the pick 2 s after its program is loaded and played (up to ~2 s on
+    # a loaded machine); one after the other they would not overlap at all.
+    assert pick.started_at is not None
+    assert pick.started_at < move_to  # the cobot took its step while the axis moved
     overlap = (min(move_to, pick_to) - max(move_from, pick_from)).total_seconds()
     assert overlap > 1.0, (move_from, move_to, pick_from, pick_to)
     assert simulation.cobot("c").read("Devices/LinearAxis/Position") == "right"
