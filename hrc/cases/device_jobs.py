@@ -89,8 +89,8 @@ def lease_next_device_job(which: Q) -> jobs.Lease | None:
         held = _why_held(device)
         if held:
             # Said on each queued call, so that the supervisor sees why nothing moves.
-            queued = Job.objects.filter(device=device, state=JobState.QUEUED)
-            queued.exclude(waiting_for=held).update(waiting_for=held)
+            waiting = Job.objects.filter(device=device, state=JobState.QUEUED)
+            waiting.exclude(waiting_for=held).update(waiting_for=held)
             return None
         queued = (
             Job.objects.filter(
