@@ -162,8 +162,11 @@ def test_the_cobot_page_and_the_device_list_show_a_devices_queue(
     admin: User, operator: User, organisation: Organisation, cobot: Cobot, axis: Device
 ) -> None:
     version = factories.make_version(organisation, published_by=admin, draft=_axis_twice())
-    case_services.start_case(version, started_by=admin, actor_mapping={})
+    case = case_services.start_case(version, started_by=admin, actor_mapping={})
 
+    # The supervisor's case page: who has the call (the device) and where it stands.
+    row = _client(admin).get(f"/cases/{case.pk}/").context["work_rows"][0]
+    assert (row.who, row.job) == ("axis1", "queued, position 1")
     for path in ("/cobots/devices/", f"/cobots/{cobot.pk}/"):
         page = _client(admin).get(path).content.decode()
         assert "move left" in page, path
