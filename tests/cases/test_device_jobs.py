@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 from django.db.models import Q
+from django.test import Client
 from django.utils import timezone
 
 from hrc.cases import device_jobs, jobs, services
@@ -355,3 +356,31 @@ def test_an_inactive_device_leases_nothing() -> None:
     job = Job.objects.get(case=case)
     assert job.state == JobState.QUEUED
     assert job.waiting_for == "device axis1 to be put back in service"
+
+
+@pytest.mark.django_db
+def test_the_start_page_offers_a_device_actor_the_devices_of_its_kind() -> None:
+    organisation = make_organisation()
+    engineer = make_member(organisation, Role.ENGINEER)
+    cobot = make_cobot(organisation, cell="cell-a")
+    axis1, axis2 = (
+        cobot_services.create_device(
+            organisation, name=name, kind="linear-axis", cell="cell-a", gateway=cobot
+        )
+        for name in ("axis1", "axis2")
+    )
+    cobot_services.create_device(organisation, name="cam", kind="part-detection", gateway=cobot)
+    version = make_version(organisation, published_by=engineer, draft=_axis_alone())
+    client = Client()
+    client.force_login(engineer)
+
+    page = client.get(f"/cases/new/?version={version.pk}").content.decode()
+    assert f'value="device:{axis2.pk}"' in page
+    assert "cam" not in page  # another kind of device
+    response = client.post(
+        f"/cases/new/?version={version.pk}",
+        {"actor__axis": f"device:{axis2.pk}", "reference": "", "count": "1"},
+    )
+    assert response.status_code == 302
+    assert Case.objects.get().actor_mapping["axis"] == {"device": axis2.pk}
+    assert axis1.pk != axis2.pk
