@@ -340,7 +340,7 @@ class StartCaseRequestSerializer(serializers.Serializer[dict[str, Any]]):
         child=serializers.DictField(),
         required=False,
         help_text="Overrides the version's default mapping per actor: {actor: {users: [...]} | "
-        "{team: id or name} | {cobot: id or name}}. Not for operators: they start with the defaults.",
+        "{team: id or name} | {cobot: id or name} | {device: id or name}}. Not for operators: they start with the defaults.",
     )
     reference = serializers.CharField(
         required=False,
@@ -440,7 +440,7 @@ class ActorMappingSerializer(serializers.Serializer[PatternVersion]):
         child=serializers.DictField(),
         source="default_actor_mapping",
         help_text="{actor: {users: [ids or usernames]} | {team: id or name} | "
-        "{cobot: id or name}}; stored with ids.",
+        "{cobot: id or name} | {device: id or name}}; stored with ids.",
     )
 
 
