@@ -287,7 +287,8 @@ class CobotCommand(models.Model):
 
 
 class CellStop(models.Model):
-    """A tablet's STOP: every cobot of the cell paused until someone confirms resuming.
+    """A tablet's STOP: every cobot of the cell paused, and no call of the cell's devices
+    started, until someone confirms resuming.
 
     A convenience, not a safety function: the robots' own safety systems stay in
     charge, and nothing here clears a protective or emergency stop.
