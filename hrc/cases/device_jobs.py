@@ -42,6 +42,9 @@ from hrc.engine.petri import Marking
 
 logger = logging.getLogger(__name__)
 
+# The name of the gateway session the devices' calls go through (runner.driver_for).
+DEVICE_SESSION = "devices"
+
 
 def is_device_job(job_id: int) -> bool:
     """Whether the job is a device's (its doorbell rings the device's queue)."""
@@ -172,7 +175,9 @@ def _call(lease: jobs.Lease, sent: list[dt.datetime]) -> dict[str, Any]:
             f"{command['method']} went to device {name} before and its answer was lost; it is "
             "not sent again by itself. Check the device, then retry or skip."
         )
-    driver = driver_for_cobot(lease.cobot, step_timeout=lease.timeout)
+    # A session of its own on the gateway: a gateway answers one session's requests one after
+    # another, and a call that lasts (an axis move) would hold up its cobot's step handshake.
+    driver = driver_for_cobot(lease.cobot, step_timeout=lease.timeout, session=DEVICE_SESSION)
     marked = Job.objects.filter(pk=lease.job_id, lease=lease.lease, state=JobState.RUNNING)
     if not marked.update(sent_at=timezone.now()):
         raise CommandRefused("The call was taken over by another worker before it was sent.")

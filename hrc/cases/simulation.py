@@ -50,6 +50,7 @@ from django.utils import timezone
 
 from hrc.cases import dispatch, jobs, services
 from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus, WorkItemKind, WorkItemState
+from hrc.cases.device_jobs import DEVICE_SESSION
 from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cobots import services as cobot_services
@@ -285,6 +286,9 @@ class Simulation:
             # The sessions first: a gateway gone under an open session makes noise in the log.
             with contextlib.suppress(Exception):
                 driver_for(self._cobot_names[actor], gateway.endpoint).close()
+            with contextlib.suppress(Exception):
+                name = self._cobot_names[actor]
+                driver_for(name, gateway.endpoint, session=DEVICE_SESSION).close()
             gateway.stop()
 
     # Running --------------------------------------------------------------------------
