@@ -139,7 +139,7 @@ describe("the timeline", () => {
 });
 
 describe("open tasks", () => {
-  const job = { cobot_name: "cobot1", state: "queued", queue_position: 2, waiting_for: "", attempt: 1, last_error: "" };
+  const job = { cobot_name: "cobot1", device_name: null, state: "queued", queue_position: 2, waiting_for: "", attempt: 1, last_error: "" };
 
   it("says where a cobot's job stands", () => {
     expect(workRow(item("tc1", "offered", { label: "pick", job })).job).toBe("queued, position 2");
@@ -158,6 +158,14 @@ describe("open tasks", () => {
     expect(workRow(item("t", "claimed", { claimed_by: "olivia" })).who).toBe("olivia");
     expect(workRow(item("tc1", "offered", { job })).who).toBe("cobot1");
     expect(workRow(item("t", "offered"))).toMatchObject({ who: "–", label: "t", job: "" });
+  });
+
+  it("names the device a device call waits for", () => {
+    const call = { ...job, cobot_name: null, device_name: "axis1", queue_position: 1 };
+    expect(workRow(item("ta1", "offered", { kind: "device", job: call }))).toMatchObject({
+      who: "axis1",
+      job: "queued, position 1",
+    });
   });
 
   it("offers to hand over an operator task, never a cobot's", () => {

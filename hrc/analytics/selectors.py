@@ -162,7 +162,8 @@ def job_rows(cases: QuerySet[Case]) -> list[JobRow]:
         "ended_at",
         "accepted_at",
     )
-    jobs = Job.objects.filter(case__in=cases).order_by("queued_at", "pk")
+    # The cobots' jobs: a device's calls run in its own queue and keep no cobot busy.
+    jobs = Job.objects.filter(case__in=cases, cobot__isnull=False).order_by("queued_at", "pk")
     return [JobRow(*row) for row in jobs.values_list(*fields)]
 
 

@@ -105,10 +105,12 @@ class WorkItemAdmin(ReadOnlyAdmin):
 
 @admin.register(Job)
 class JobAdmin(ReadOnlyAdmin):
-    list_display = ["id", "cobot", "case", "kind", "state", "attempt", "queued_at", "waiting_for"]
-    list_filter = ["state", "kind", "cobot"]
-    search_fields = ["=case__id", "cobot__name"]
-    list_select_related = ["cobot", "case"]
+    list_display = [
+        "id", "cobot", "device", "case", "kind", "state", "attempt", "queued_at", "waiting_for",
+    ]  # fmt: skip
+    list_filter = ["state", "kind", "cobot", "device"]
+    search_fields = ["=case__id", "cobot__name", "device__name"]
+    list_select_related = ["cobot", "device", "case"]
 
 
 @admin.register(Incident)

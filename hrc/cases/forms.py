@@ -13,9 +13,10 @@ from django import forms
 from django.contrib.auth.models import User
 
 from hrc.cases.services import MAX_CASES_AT_ONCE
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 from hrc.engine.model import Pattern
 from hrc.engine.startdata import StartField, start_fields
+from hrc.engine.taskconfig import device_kind_of
 from hrc.errors import Invalid
 from hrc.organisations.models import Organisation, Team
 
@@ -31,7 +32,8 @@ def data_field_name(key: str) -> str:
 
 
 class MappingForm(forms.Form):
-    """One choice per pattern actor: a team or a person for operators, a cobot for cobots."""
+    """One choice per pattern actor: a team or a person for operators, a cobot for cobots, a
+    device of its kind for a device actor."""
 
     def __init__(
         self,
@@ -54,8 +56,18 @@ class MappingForm(forms.Form):
         cobots = list(
             Cobot.objects.filter(organisation=organisation, is_active=True).order_by("name")
         )
+        devices = list(
+            Device.objects.filter(organisation=organisation, is_active=True).order_by("name")
+        )
         for actor in pattern.actors:
-            if actor.type == "cobot":
+            kind = device_kind_of(actor)
+            if kind is not None:
+                choices = [
+                    (f"device:{d.pk}", f"{d.name}{f' (cell {d.cell})' if d.cell else ''}")
+                    for d in devices
+                    if d.kind == kind
+                ]
+            elif actor.type == "cobot":
                 choices = [
                     (f"cobot:{c.pk}", f"{c.name}{f' (cell {c.cell})' if c.cell else ''}")
                     for c in cobots
@@ -83,7 +95,7 @@ class MappingForm(forms.Form):
                 chosen[actor.id] = {
                     "users": [int(i) for i in ids.split(",") if i.isascii() and i.isdigit()]
                 }
-            elif kind in ("team", "cobot") and ids.isascii() and ids.isdigit():
+            elif kind in ("team", "cobot", "device") and ids.isascii() and ids.isdigit():
                 chosen[actor.id] = {kind: int(ids)}
         return chosen
 
@@ -237,6 +249,8 @@ def _choice_of(binding: Any) -> str:
         return ""
     if "cobot" in binding:
         return f"cobot:{binding['cobot']}"
+    if "device" in binding:
+        return f"device:{binding['device']}"
     if "team" in binding:
         return f"team:{binding['team']}"
     users = binding.get("users") or []

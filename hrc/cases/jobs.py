@@ -1,5 +1,9 @@
 """Running jobs on cobots: the worker's side of a case. Called by the thin Celery tasks.
 
+(A device's calls have a queue of their own, hrc.cases.device_jobs; they share this
+module's finish and fail paths, and its sweeper. Lock order: cobot row, or a device job's
+device row, then case row, then job row.)
+
 One cobot runs one job at a time. `run_next_job` takes the cobot's row lock,
 and only when no job of that cobot is running does it lease the first
 queued job that may start (first come, first served; a job whose case is
@@ -57,7 +61,7 @@ from hrc.cobots.drivers.base import (
     StepCommand,
 )
 from hrc.cobots.drivers.runner import SyncDriver, driver_for_cobot
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import CaseNet
 from hrc_gateway import urua
@@ -81,8 +85,9 @@ class Lease:
     kind: str
     command: dict[str, Any]
     timeout: float
-    cobot: Cobot
+    cobot: Cobot  # a device job's: the cobot whose gateway serves the device
     sent_before: bool
+    device: Device | None = None
 
 
 def run_next_job(job_id: int) -> None:
@@ -370,9 +375,14 @@ def finish_job(
 
 
 def _ring_for_next_on_commit(job: Job) -> None:
-    """Rings the cobot's doorbell for its next job once this transaction has committed, if one
-    is queued then (progress.ring_for_next_job_on_commit)."""
-    progress.ring_for_next_job_on_commit(job.pk, job.cobot_id)
+    """Rings the doorbell of the job's queue (its cobot's or its device's) for the next job once
+    this transaction has committed, if one is queued then (progress.ring_for_next_on_commit)."""
+    progress.ring_for_next_on_commit(job)
+
+
+def _publish_queue(job: Job) -> None:
+    if job.cobot_id is not None:  # a device's queue is read afresh (device_jobs.device_queue)
+        events.publish_cobot_queue(job.cobot_id)
 
 
 def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | None = None) -> None:
@@ -437,7 +447,7 @@ def _ended_with_case(case: Case, job: Job) -> bool:
         return False
     job.state, job.ended_at = JobState.CANCELLED, timezone.now()
     job.save()
-    events.publish_cobot_queue(job.cobot_id)
+    _publish_queue(job)
     _ring_for_next_on_commit(job)
     return True
 
@@ -485,19 +495,18 @@ def sweep() -> dict[str, int]:
 
 
 def _first_due_per_cobot(now: dt.datetime) -> list[int]:
-    """The first due job of each cobot that has nothing running, leaving out the jobs another
-    case's func hold keeps waiting (the holding case's own may go)."""
-    busy = set(Job.objects.filter(state=JobState.RUNNING).values_list("cobot_id", flat=True))
-    firsts: dict[int, int] = {}
-    due = (
-        Job.objects.filter(
-            state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
-        )
-        .exclude(cobot_id__in=busy)
-        .exclude(Exists(_held_by_another_case(OuterRef("cobot_id"))))
-    )
-    for job_id, cobot_id in due.order_by("queued_at", "id").values_list("pk", "cobot_id"):
-        firsts.setdefault(cobot_id, job_id)
+    """The first due job of each queue (a cobot's, a device's) that has nothing running,
+    leaving out the jobs another case's func hold keeps waiting (the holding case's own may go)."""
+    queues = ("cobot_id", "device_id")
+    busy = set(Job.objects.filter(state=JobState.RUNNING).values_list(*queues))
+    firsts: dict[tuple[int | None, int | None], int] = {}
+    due = Job.objects.filter(
+        state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
+    ).exclude(Exists(_held_by_another_case(OuterRef("cobot_id"))))
+    for job_id, *queue in due.order_by("queued_at", "id").values_list("pk", *queues):
+        key = (queue[0], queue[1])
+        if key not in busy:
+            firsts.setdefault(key, job_id)
     return list(firsts.values())
 
 
@@ -526,5 +535,5 @@ def _expire_lease(job_id: int, case_id: int) -> None:
             job.state, job.next_try_at = JobState.QUEUED, timezone.now()
             job.save()
         case.save()
-        events.publish_cobot_queue(job.cobot_id)
+        _publish_queue(job)
         dispatch.send_on_commit(Task.RUN_JOB, job.pk)

@@ -25,7 +25,7 @@ from hrc.cases.choices import (
     WorkItemKind,
     WorkItemState,
 )
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 from hrc.organisations.models import Organisation, Team
 from hrc.patterns.models import PatternVersion
 
@@ -89,6 +89,10 @@ class WorkItem(models.Model):
     )  # fmt: skip
     team = models.ForeignKey(Team, on_delete=models.SET_NULL, null=True, blank=True)
     cobot = models.ForeignKey(Cobot, on_delete=models.PROTECT, null=True, blank=True)
+    device = models.ForeignKey(
+        Device, on_delete=models.PROTECT, null=True, blank=True, related_name="work_items",
+        help_text="The device a device call runs on (its own queue, not its cobot's).",
+    )  # fmt: skip
     claimed_by = models.ForeignKey(
         _USER, on_delete=models.SET_NULL, null=True, blank=True, related_name="+"
     )
@@ -117,7 +121,8 @@ class WorkItem(models.Model):
 
 
 class Job(models.Model):
-    """A command to a cobot for a work item: the row is the lock, the Celery message only its id.
+    """A command to a cobot or a device for a work item: the row is the lock, the Celery message
+    only its id. A device call is the device's job, in the device's queue (cases.device_jobs).
 
     The fencing token sent with a step is (id, attempt). `attempt` changes
     only when a person asks for the step to run again; automatic retries and
@@ -128,7 +133,12 @@ class Job(models.Model):
 
     work_item = models.OneToOneField(WorkItem, on_delete=models.CASCADE, related_name="job")
     case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="jobs")
-    cobot = models.ForeignKey(Cobot, on_delete=models.PROTECT, related_name="jobs")
+    cobot = models.ForeignKey(
+        Cobot, on_delete=models.PROTECT, null=True, blank=True, related_name="jobs"
+    )
+    device = models.ForeignKey(
+        Device, on_delete=models.PROTECT, null=True, blank=True, related_name="jobs"
+    )
     kind = models.CharField(max_length=20, choices=WorkItemKind.choices)
     command = models.JSONField(
         help_text="Step: program, number, workspace, poses. Device: method, args."
@@ -160,10 +170,21 @@ class Job(models.Model):
 
     class Meta:
         ordering = ["queued_at", "id"]
-        indexes = [models.Index(fields=["cobot", "state", "queued_at"])]
+        indexes = [
+            models.Index(fields=["cobot", "state", "queued_at"]),
+            models.Index(fields=["device", "state", "queued_at"]),
+        ]
+        constraints = [
+            # In one queue exactly: a cobot's or a device's.
+            models.CheckConstraint(
+                condition=Q(cobot__isnull=True) ^ Q(device__isnull=True),
+                name="job_on_a_cobot_or_a_device",
+            )
+        ]
 
     def __str__(self) -> str:
-        return f"job {self.pk} ({self.kind} on {self.cobot_id}, {self.state})"
+        on = f"cobot {self.cobot_id}" if self.cobot_id else f"device {self.device_id}"
+        return f"job {self.pk} ({self.kind} on {on}, {self.state})"
 
     @property
     def fence(self) -> tuple[int, int]:

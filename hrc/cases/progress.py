@@ -6,8 +6,8 @@ cobot's), queueing jobs, space constraints' interruptions, and the end of a
 case. Each function expects the case row lock held (lock_case and
 lock_operator_item take it) and leaves saving the case to its caller: the public
 commands (services.py) and the workers (jobs.py, messages.py) lock and check
-first. Lock order, everywhere: cobot row, then case row, then job row, then
-interruption row.
+first. Lock order, everywhere: cobot row (a device's job: the device row), then case
+row, then job row, then interruption row.
 """
 
 from __future__ import annotations
@@ -211,10 +211,12 @@ def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
     config = net.tasks[task]
     actor = net.performers[task]
     binding = case.actor_mapping[actor]
+    device_id = _device_of(binding, config)
     item = WorkItem.objects.create(
         case=case, task=task, label=net.labels[task], actor=actor,
-        kind=config.kind, instructions=config.instructions,
-        team_id=binding.get("team"), cobot_id=binding.get("cobot"),
+        kind=config.kind, instructions=config.instructions, team_id=binding.get("team"),
+        # A device call is its device's work: the cobot's queue stays free meanwhile.
+        cobot_id=None if device_id else binding.get("cobot"), device_id=device_id,
     )  # fmt: skip
     if config.kind == "operator":
         # A new item has no candidates yet: insert them in one statement.
@@ -228,11 +230,24 @@ def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
     return item
 
 
+def _device_of(binding: Mapping[str, Any], config: TaskConfig) -> int | None:
+    """The device a device call runs on (mapping.py resolved it at the start); None for another
+    task, and for a call of a case started before devices had queues (its cobot runs it)."""
+    if config.device is None:
+        return None
+    if "device" in binding:
+        return int(binding["device"])
+    device_id = binding.get("devices", {}).get(config.device.call.split(".")[0])
+    return None if device_id is None else int(device_id)
+
+
 def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> None:
-    assert item.cobot_id is not None  # a cobot task's actor maps to a cobot (mapping.py)
+    # A cobot task's actor maps to a cobot, a device call to a device (mapping.py).
+    assert item.cobot_id is not None or item.device_id is not None
     now = timezone.now()
     job = Job(
-        work_item=item, case=case, cobot_id=item.cobot_id, kind=config.kind,
+        work_item=item, case=case, cobot_id=item.cobot_id, device_id=item.device_id,
+        kind=config.kind,
         timeout=config.timeout, retries_left=config.retries, next_try_at=now, command={},
     )  # fmt: skip
     try:
@@ -522,7 +537,21 @@ def _end_hold(job: Job) -> None:
     """The cobot a func hold reserved for this case is free once this transaction commits: its
     next job goes now, not at the next sweep. Held items end only by completing (advance's
     held completions, which a skip or a message reaches too) or by withdrawal (the case ends)."""
-    ring_for_next_job_on_commit(job.pk, job.cobot_id)
+    ring_for_next_on_commit(job)
+
+
+def ring_for_next_on_commit(job: Job) -> None:
+    """Rings the doorbell of the job's queue after commit: its device's for a device call,
+    else its cobot's (ring_for_next_job_on_commit)."""
+    if job.device_id is None:
+        ring_for_next_job_on_commit(job.pk, job.cobot_id)  # type: ignore[arg-type]
+        return
+    device_id = job.device_id
+
+    def queued() -> bool:
+        return Job.objects.filter(device_id=device_id, state=JobState.QUEUED).exists()
+
+    dispatch.send_on_commit_if(queued, Task.RUN_JOB, job.pk)
 
 
 def ring_for_next_job_on_commit(job_id: int, cobot_id: int) -> None:
@@ -566,6 +595,9 @@ def retry_job(case: Case, net: CaseNet, item: WorkItem, again: bool) -> None:
         0,
     )
     job.next_try_at, job.last_error = timezone.now(), ""
+    # A person checked the device and asks for the call: it goes out once more. (By itself,
+    # a call that may have gone out is never sent again: device_jobs, jobs._call_device.)
+    job.sent_at = None
     if again:
         job.attempt += 1
     job.save()

@@ -7,6 +7,7 @@ user already) take a cobot as it is.
 """
 
 from collections.abc import Iterable
+from typing import Any
 
 from django.contrib.auth.models import User
 from django.db.models import Case as SqlCase
@@ -67,7 +68,7 @@ def work_items_visible_to(user: AnyUser) -> QuerySet[WorkItem]:
     """Every work item, open or not, of the user's organisations' cases (read access)."""
     return (
         work_items_of_organisations_of(user)
-        .select_related("case__version", "claimed_by", "completed_by", "cobot", "job")
+        .select_related("case__version", "claimed_by", "completed_by", "cobot", "device", "job")
         .annotate(queue_position=_queue_position("job__"))
     )
 
@@ -142,12 +143,13 @@ def jobs_visible_to(user: AnyUser) -> QuerySet[Job]:
 
 
 def cobot_queues(user: AnyUser) -> QuerySet[Job]:
-    """Queued and running jobs in queue order: per cobot, the running one, then first come first served."""
+    """Queued and running jobs in queue order: per cobot, then per device, the running one, then
+    first come first served."""
     running_first = SqlCase(When(state=JobState.RUNNING, then=Value(0)), default=Value(1))
     return (
         jobs_visible_to(user)
         .filter(state__in=QUEUE_STATES)
-        .order_by("cobot_id", running_first, "queued_at", "id")
+        .order_by("cobot_id", "device_id", running_first, "queued_at", "id")
     )
 
 
@@ -162,12 +164,17 @@ def _queue_position(prefix: str) -> SqlCase:
 
 
 def _queued_ahead(prefix: str) -> Coalesce:
-    """How many queued jobs of the same cobot came before the job at `prefix` (FCFS order)."""
+    """How many queued jobs of the same queue (cobot or device) came before the job at `prefix` (FCFS order)."""
     earlier = Q(queued_at__lt=OuterRef(f"{prefix}queued_at")) | Q(
         queued_at=OuterRef(f"{prefix}queued_at"), pk__lt=OuterRef(f"{prefix}pk")
     )
     ahead = (
-        Job.objects.filter(earlier, cobot_id=OuterRef(f"{prefix}cobot_id"), state=JobState.QUEUED)
+        # The same queue: the job's cobot's, or its device's (a NULL matches neither).
+        Job.objects.filter(
+            earlier,
+            Q(cobot_id=OuterRef(f"{prefix}cobot_id")) | Q(device_id=OuterRef(f"{prefix}device_id")),
+            state=JobState.QUEUED,
+        )
         .order_by()
         .values("cobot_id")
         .annotate(n=Count("pk"))
@@ -305,3 +312,20 @@ def cobot_queue_lengths(cobot_ids: Iterable[int]) -> dict[int, int]:
         .annotate(n=Count("id"))
     )
     return {row["cobot_id"]: row["n"] for row in counts}
+
+
+def device_queues(device_ids: Iterable[int]) -> dict[int, list[dict[str, Any]]]:
+    """Each device's running call, then its queued ones first come first served, by device id."""
+    running_first = SqlCase(When(state=JobState.RUNNING, then=Value(0)), default=Value(1))
+    queues: dict[int, list[dict[str, Any]]] = {}
+    rows = (
+        Job.objects.filter(device_id__in=list(device_ids), state__in=QUEUE_STATES)
+        .order_by("device_id", running_first, "queued_at", "id")
+        .values_list("device_id", "case_id", "work_item__label", "work_item__task", "state",
+                     "waiting_for")
+    )  # fmt: skip
+    for device_id, case_id, label, task, state, waiting_for in rows:
+        queues.setdefault(device_id, []).append(
+            {"case": case_id, "label": label or task, "state": state, "waiting_for": waiting_for}
+        )
+    return queues

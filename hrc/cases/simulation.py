@@ -50,15 +50,19 @@ from django.utils import timezone
 
 from hrc.cases import dispatch, jobs, services
 from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus, WorkItemKind, WorkItemState
+from hrc.cases.device_jobs import DEVICE_SESSION
 from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
 from hrc.cases.nets import case_net
+from hrc.cobots import services as cobot_services
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 from hrc.cobots.simulated import GatewayProcess
 from hrc.engine.model import Pattern
+from hrc.engine.taskconfig import DEVICE_KINDS, device_kind_of, device_kinds_called
 from hrc.errors import Refusal
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation
+from hrc.organisations.services import ensure_cell
 from hrc.patterns import services as pattern_services
 from hrc.patterns.models import PatternVersion
 from hrc_gateway.sim.state import read_step_log
@@ -167,6 +171,8 @@ class Simulation:
         self._pool: ThreadPoolExecutor | None = None
         self._cobot_names: dict[str, str] = {}
         self._cobots: dict[str, Cobot] = {}
+        self._devices: dict[str, Device] = {}
+        self._with_devices = False
         self._variants: list[CaseVariant] = []
         self._started = 0
         self._answers: Counter[tuple[int, str]] = Counter()
@@ -206,18 +212,34 @@ class Simulation:
                 name: actor for actor, name in variant.actors.items() if name not in stand_ins
             }
         types = {actor.id: actor.type for actor in net.pattern.actors}
+        kinds = {actor.id: device_kind_of(actor) for actor in net.pattern.actors}
+        self._with_devices = bool(device_kinds_called(net.pattern)) or any(kinds.values())
         for name, actor in stand_ins.items():
             if types[actor] == "operator":
                 self.users[name] = self._member(f"rp-{suffix}-{name}", Role.OPERATOR)
-            else:
+            elif kinds[actor] is None:
                 self._cobots[name] = self._simulated_cobot(name)
+        for name, actor in stand_ins.items():
+            kind = kinds[actor]
+            if kind is not None:
+                self._devices[name] = self._device_for(name, kind)
         mapping = {actor.id: self._binding(actor.id) for actor in net.pattern.actors}
         services.set_default_actor_mapping(self.version, mapping)
 
     def _binding(self, stand_in: str) -> dict[str, Any]:
         if stand_in in self.users:
             return {"users": [self.users[stand_in].pk]}
+        if stand_in in self._devices:
+            return {"device": self._devices[stand_in].pk}
         return {"cobot": self._cobots[stand_in].pk}
+
+    def _device_for(self, stand_in: str, kind: str) -> Device:
+        """A device actor's device: the first cobot's cell's, as a cell's devices are served
+        beside its cobot (a gateway of its own when the pattern has no cobot)."""
+        if not self._cobots:
+            self._cobots[stand_in] = self._simulated_cobot(stand_in)
+        cobot = next(iter(self._cobots.values()))
+        return Device.objects.get(gateway=cobot, kind=kind)
 
     def _member(self, username: str, role: str) -> User:
         user = User.objects.create_user(username)
@@ -235,9 +257,21 @@ class Simulation:
         driver = driver_for(name, gateway.endpoint, step_timeout=30.0)
         if self.power_on:
             driver.call("PowerOn", timeout=30)  # the simulator's PowerOn releases the brakes too
-        return Cobot.objects.create(
-            organisation=self.organisation, name=name, endpoint=gateway.endpoint
+        if not self._with_devices:
+            return Cobot.objects.create(
+                organisation=self.organisation, name=name, endpoint=gateway.endpoint
+            )
+        # Each cobot stands in a cell of its own, with every kind of device beside it on its
+        # gateway (the simulator serves them all under Devices/).
+        ensure_cell(self.organisation, actor)
+        cobot = Cobot.objects.create(
+            organisation=self.organisation, name=name, endpoint=gateway.endpoint, cell=actor
         )
+        for kind in DEVICE_KINDS:
+            cobot_services.create_device(
+                self.organisation, name=f"{kind}-{actor}", kind=kind, cell=actor, gateway=cobot
+            )
+        return cobot
 
     def cobot(self, actor: str) -> SyncDriver:
         """A driver to the actor's simulated cobot (or a stand-in's, by its name), to look at it
@@ -265,6 +299,9 @@ class Simulation:
             # The sessions first: a gateway gone under an open session makes noise in the log.
             with contextlib.suppress(Exception):
                 driver_for(self._cobot_names[actor], gateway.endpoint).close()
+            with contextlib.suppress(Exception):
+                name = self._cobot_names[actor]
+                driver_for(name, gateway.endpoint, session=DEVICE_SESSION).close()
             gateway.stop()
 
     # Running --------------------------------------------------------------------------

@@ -7,15 +7,19 @@ registered under its dispatch.Task name, which is how the cases app sends it.
 
 from celery import shared_task
 
-from hrc.cases import interruptions, jobs
+from hrc.cases import device_jobs, interruptions, jobs
 from hrc.cases.dispatch import Task
 from hrc.cases.messages import deliver_sent_message, purge_expired_messages, sweep_sent_messages
 
 
 @shared_task(name=Task.RUN_JOB.value, ignore_result=True)
 def run_job(job_id: int) -> None:
-    """Rings a cobot's doorbell: runs its next job that may run (not necessarily `job_id`)."""
-    jobs.run_next_job(job_id)
+    """Rings the doorbell of `job_id`'s queue, a cobot's or a device's: runs its next job that may
+    run (not necessarily `job_id`)."""
+    if device_jobs.is_device_job(job_id):
+        device_jobs.run_next_device_job(job_id)
+    else:
+        jobs.run_next_job(job_id)
 
 
 @shared_task(name=Task.SWEEP.value, ignore_result=True)

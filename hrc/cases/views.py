@@ -211,6 +211,8 @@ def work_row(item: WorkItem) -> WorkRow:
     who = item.claimed_by.get_username() if item.claimed_by else ""
     if not who and item.cobot is not None:
         who = item.cobot.name
+    if not who and item.device is not None:
+        who = item.device.name
     reassignable = item.kind == WorkItemKind.OPERATOR and item.state in OPEN_WORK_ITEM_STATES
     label = item.label or item.task
     return WorkRow(item.task, label, item.state, who or "–", _job_text(item, job), item.pk, reassignable)  # fmt: skip

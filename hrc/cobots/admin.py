@@ -1,4 +1,4 @@
-"""Admin pages for cobots; saves go through hrc.cobots.services."""
+"""Admin pages for cobots and devices; saves go through hrc.cobots.services."""
 
 from __future__ import annotations
 
@@ -14,13 +14,15 @@ from django.urls import URLPattern, path, reverse
 from django.views.decorators.http import require_POST
 
 from hrc.cobots import selectors, services
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 
 # Generic for mypy only: Django's runtime class is not subscriptable.
 if TYPE_CHECKING:
     CobotAdminBase = admin.ModelAdmin[Cobot]
+    DeviceAdminBase = admin.ModelAdmin[Device]
 else:
     CobotAdminBase = admin.ModelAdmin
+    DeviceAdminBase = admin.ModelAdmin
 
 
 @admin.register(Cobot)
@@ -98,3 +100,22 @@ class CobotAdmin(CobotAdminBase):
     def delete_queryset(self, request: HttpRequest, queryset: QuerySet[Cobot]) -> None:
         for cobot in queryset:
             services.delete_cobot(cobot)
+
+
+@admin.register(Device)
+class DeviceAdmin(DeviceAdminBase):
+    list_display = ["name", "organisation", "kind", "cell", "gateway", "is_active"]
+    list_filter = ["kind", "is_active", "organisation"]
+    search_fields = ["name", "cell", "organisation__name"]
+    list_select_related = ["organisation", "gateway"]
+    readonly_fields = ["created_at", "updated_at"]
+
+    def save_model(
+        self, request: HttpRequest, obj: Device, form: BaseModelForm[Device], change: bool
+    ) -> None:
+        fields = {name: getattr(obj, name) for name in services.DEVICE_FIELDS}
+        if change:
+            services.update_device(obj, **fields)
+            return
+        created = services.create_device(obj.organisation, **fields)
+        obj.pk, obj._state.adding = created.pk, False

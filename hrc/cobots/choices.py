@@ -2,6 +2,8 @@
 
 from django.db import models
 
+from hrc.engine.taskconfig import DEVICE_KINDS
+
 
 class DriverKind(models.TextChoices):
     """Which driver talks to the cobot."""
@@ -51,3 +53,8 @@ class CommandOutcome(models.TextChoices):
     REFUSED = "refused", "Refused"
     # The cobot could not be reached or did not answer in time: it may not have happened.
     FAILED = "failed", "Failed"
+
+
+# The kinds of device a cell may have: the prefixes of the device calls a task can make
+# (hrc.engine.taskconfig.DEVICE_CALLS), so a call and a device of its kind always meet.
+DEVICE_KIND_CHOICES = [(kind, kind.replace("-", " ").capitalize()) for kind in DEVICE_KINDS]

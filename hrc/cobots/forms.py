@@ -1,4 +1,4 @@
-"""The form that registers or edits a cobot; hrc.cobots.services writes it.
+"""The forms that register or edit a cobot or a device; hrc.cobots.services writes them.
 
 The cell is chosen among the organisation's cells, so another organisation's
 cell (or a mistyped one) is "not one of the choices" at its field.
@@ -11,7 +11,7 @@ from typing import Any
 from django import forms
 from django.core.exceptions import ValidationError
 
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 from hrc.organisations.selectors import cells_of
 
 
@@ -42,12 +42,7 @@ class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs make
         return name
 
     def add_service_errors(self, error: ValidationError) -> None:
-        """Puts a service's refusal at its field (or above the form when it names none)."""
-        if hasattr(error, "error_dict"):
-            for field, messages in error.message_dict.items():
-                self.add_error(field if field in self.fields else None, messages)
-        else:
-            self.add_error(None, error.messages)
+        add_service_errors(self, error)
 
 
 class CredentialsSecretForm(forms.Form):
@@ -71,3 +66,48 @@ class CredentialsSecretForm(forms.Form):
     def add_service_errors(self, error: ValidationError) -> None:
         for field, messages in error.message_dict.items():
             self.add_error(field if field in self.fields else None, messages)
+
+
+class DeviceForm(forms.ModelForm):  # type: ignore[type-arg]  # as CobotForm
+    """Registers or edits a device: its cell among the organisation's, its gateway among the
+    organisation's cobots (another's is "not one of the choices")."""
+
+    cell = forms.ChoiceField(
+        required=False,
+        help_text="The cell it stands in: that cell's cobots call it, and the cell's STOP holds it.",
+    )
+
+    class Meta:
+        model = Device
+        fields = ["name", "kind", "cell", "gateway", "is_active"]
+
+    def __init__(self, data: Any = None, *, instance: Device) -> None:
+        super().__init__(data, instance=instance)
+        names = list(cells_of(instance.organisation_id).values_list("name", flat=True))
+        if instance.cell and instance.cell not in names:
+            names.append(instance.cell)
+        cell = self.fields["cell"]
+        assert isinstance(cell, forms.ChoiceField)
+        cell.choices = [("", "– the whole floor –"), *((name, name) for name in names)]
+        gateway = self.fields["gateway"]
+        assert isinstance(gateway, forms.ModelChoiceField)
+        gateway.queryset = Cobot.objects.filter(organisation_id=instance.organisation_id)
+
+    def clean_name(self) -> str:
+        name: str = self.cleaned_data["name"]
+        taken = Device.objects.filter(organisation_id=self.instance.organisation_id, name=name)
+        if taken.exclude(pk=self.instance.pk).exists():
+            raise ValidationError(f"The organisation already has a device named {name}.")
+        return name
+
+    def add_service_errors(self, error: ValidationError) -> None:
+        add_service_errors(self, error)
+
+
+def add_service_errors(form: forms.BaseForm, error: ValidationError) -> None:
+    """Puts a service's refusal at its field (or above the form when it names none)."""
+    if hasattr(error, "error_dict"):
+        for field, messages in error.message_dict.items():
+            form.add_error(field if field in form.fields else None, messages)
+    else:
+        form.add_error(None, error.messages)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
+from typing import Any
 
 from django.core.exceptions import ImproperlyConfigured
 
@@ -26,6 +27,11 @@ QueueLengths = Callable[[Collection[int]], dict[int, int]]
 HeldByInterruption = Callable[[int], bool]
 # The cobot's queue may go on (a STOP ended): start its next job after commit, if one waits.
 QueueReleased = Callable[[int], None]
+# Each device's queued and running calls in queue order, by device id (absent: none); each a
+# dict with "case", "label", "state" and "waiting_for".
+DeviceQueues = Callable[[Collection[int]], dict[int, list[dict[str, Any]]]]
+# The devices' queues may go on (their cell's STOP ended): start their next calls after commit.
+DevicesReleased = Callable[[Collection[int]], None]
 # Tell the tablets after commit: the cobot's queue changed / a STOP began, changed or ended.
 QueueChanged = Callable[[int], None]
 StopChanged = Callable[[CellStop], None]
@@ -39,6 +45,8 @@ class _CobotUse:
     queue_released: QueueReleased | None = None
     queue_changed: QueueChanged | None = None
     stop_changed: StopChanged | None = None
+    devices_released: DevicesReleased | None = None
+    device_queues: DeviceQueues | None = None
 
 
 _REGISTERED = _CobotUse()
@@ -74,6 +82,29 @@ def register_cobot_queues(
     """Called once by the app that runs cases, from its receivers."""
     _REGISTERED.held_by_interruption = held_by_interruption
     _REGISTERED.queue_released = queue_released
+
+
+def register_device_queues(
+    *, devices_released: DevicesReleased, device_queues: DeviceQueues
+) -> None:
+    """Called once by the app that runs cases, from its receivers."""
+    _REGISTERED.devices_released = devices_released
+    _REGISTERED.device_queues = device_queues
+
+
+def device_queues(device_ids: Collection[int]) -> dict[int, list[dict[str, Any]]]:
+    """The devices' queues by id ([] for those with none)."""
+    if _REGISTERED.device_queues is None:
+        raise ImproperlyConfigured("No app has registered device_queues (hrc.cases does).")
+    queues = _REGISTERED.device_queues(device_ids)
+    return {device_id: queues.get(device_id, []) for device_id in device_ids}
+
+
+def devices_released(device_ids: Collection[int]) -> None:
+    """Starts the devices' next queued calls once the transaction commits, if any wait."""
+    if _REGISTERED.devices_released is None:
+        raise ImproperlyConfigured("No app has registered devices_released (hrc.cases does).")
+    _REGISTERED.devices_released(device_ids)
 
 
 def register_tablets(*, queue_changed: QueueChanged, stop_changed: StopChanged) -> None:

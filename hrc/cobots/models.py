@@ -7,11 +7,19 @@ reach another's robot by its address or its credentials. CellStop records
 each STOP a tablet gave (hrc.cobots.stops).
 """
 
+from collections.abc import Collection
+
 from django.conf import settings
 from django.core.exceptions import ValidationError
 from django.db import models
 
-from hrc.cobots.choices import CommandOutcome, ControlCommand, CredentialsKind, DriverKind
+from hrc.cobots.choices import (
+    DEVICE_KIND_CHOICES,
+    CommandOutcome,
+    ControlCommand,
+    CredentialsKind,
+    DriverKind,
+)
 from hrc.cobots.validators import (
     split_credentials_source,
     validate_credentials_source,
@@ -279,7 +287,8 @@ class CobotCommand(models.Model):
 
 
 class CellStop(models.Model):
-    """A tablet's STOP: every cobot of the cell paused until someone confirms resuming.
+    """A tablet's STOP: every cobot of the cell paused, and no call of the cell's devices
+    started, until someone confirms resuming.
 
     A convenience, not a safety function: the robots' own safety systems stay in
     charge, and nothing here clears a protective or emergency stop.
@@ -316,3 +325,79 @@ class CellStop(models.Model):
 
     def __str__(self) -> str:
         return f"STOP of {self.cell or 'the floor'} at {self.stopped_at:%H:%M:%S}"
+
+
+class Device(models.Model):
+    """A device of a cell (a linear axis, a part detection camera, a display…) with a queue of
+    its own: one call at a time, first come first served (hrc.cases.device_jobs).
+
+    Its calls go through the OPC UA gateway of a registered cobot (`gateway`), as the
+    prototype's URUA served a cell's devices beside its cobot: credentials and endpoints stay
+    in one place, the cobot's.
+    """
+
+    organisation = models.ForeignKey(
+        Organisation,
+        on_delete=models.CASCADE,
+        related_name="devices",
+        help_text="The organisation that runs this device.",
+    )
+    name = models.CharField(
+        max_length=100, help_text="The device's name, unique in the organisation (e.g. axis1)."
+    )
+    kind = models.CharField(
+        max_length=30,
+        choices=DEVICE_KIND_CHOICES,
+        help_text="What it does; a task's device call of this kind may run on it.",
+    )
+    cell = models.CharField(
+        max_length=50,
+        blank=True,
+        default="",
+        validators=[validate_cell],
+        help_text=(
+            "The work cell it stands in; a cobot task of that cell calls it, and the cell's STOP "
+            "holds its calls. Empty: the whole floor (with the cobots that have no cell)."
+        ),
+    )
+    gateway = models.ForeignKey(
+        Cobot,
+        on_delete=models.PROTECT,
+        related_name="devices",
+        help_text="The registered cobot whose OPC UA gateway serves the device (under Devices/).",
+    )
+    is_active = models.BooleanField(
+        default=True, help_text="Untick to take the device out of service; no call is sent to it."
+    )
+    created_at = models.DateTimeField(auto_now_add=True)
+    updated_at = models.DateTimeField(auto_now=True)
+
+    class Meta:
+        ordering = ["organisation__name", "name"]
+        constraints = [
+            models.UniqueConstraint(
+                fields=["organisation", "name"],
+                name="device_name_unique_in_organisation",
+                violation_error_message="The organisation already has a device of this name.",
+            )
+        ]
+
+    def __str__(self) -> str:
+        return self.name
+
+    def validate_constraints(self, exclude: Collection[str] | None = None) -> None:
+        # Its one constraint is about the name: said at the name's field, not above the form.
+        try:
+            super().validate_constraints(exclude=exclude)
+        except ValidationError as error:
+            raise ValidationError({"name": error.messages}) from None
+
+    def clean(self) -> None:
+        """The gateway is a cobot of the device's own organisation: no calls through another's."""
+        if (
+            self.gateway_id is not None
+            and not Cobot.objects.filter(
+                pk=self.gateway_id, organisation_id=self.organisation_id
+            ).exists()
+        ):
+            raise ValidationError({"gateway": "The gateway must be a cobot of the organisation."})

@@ -6,7 +6,7 @@ from django.db.models import QuerySet
 
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
-from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
+from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret, Device
 from hrc.organisations.selectors import AnyUser, organisations_of
 
 
@@ -14,6 +14,22 @@ def cobots_visible_to(user: AnyUser) -> QuerySet[Cobot]:
     """The cobots of every organisation the user belongs to; none for an outsider."""
     return Cobot.objects.filter(organisation__in=organisations_of(user)).select_related(
         "organisation"
+    )
+
+
+def devices_visible_to(user: AnyUser) -> QuerySet[Device]:
+    """The devices of every organisation the user belongs to; none for an outsider."""
+    return Device.objects.filter(organisation__in=organisations_of(user)).select_related(
+        "organisation", "gateway"
+    )
+
+
+def devices_of(organisation_id: int) -> QuerySet[Device]:
+    """The organisation's devices by cell and name, with the cobots whose gateways serve them."""
+    return (
+        Device.objects.filter(organisation_id=organisation_id)
+        .select_related("gateway")
+        .order_by("cell", "name")
     )
 
 

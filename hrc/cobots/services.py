@@ -9,7 +9,7 @@ from django.core.exceptions import ValidationError
 from django.db import IntegrityError, transaction
 
 from hrc.cobots.credentials import seal
-from hrc.cobots.models import Cobot, CredentialsSecret
+from hrc.cobots.models import Cobot, CredentialsSecret, Device
 from hrc.cobots.validators import validate_secret_name
 from hrc.organisations.models import Organisation
 from hrc.organisations.services import ensure_cell
@@ -75,6 +75,48 @@ def _reject_unknown(fields: dict[str, Any]) -> None:
     unknown = set(fields) - set(EDITABLE_FIELDS)
     if unknown:
         raise TypeError(f"Not editable on a cobot: {', '.join(sorted(unknown))}")
+
+
+# Devices -----------------------------------------------------------------------------
+
+DEVICE_FIELDS = ("name", "kind", "cell", "gateway", "is_active")
+
+
+def create_device(organisation: Organisation, **fields: Any) -> Device:
+    """Registers a device of a cell; `fields` are among DEVICE_FIELDS (`gateway`: a Cobot of the
+    organisation). Raises ValidationError when a value breaks the model's rules."""
+    _reject_unknown_device_fields(fields)
+    device = Device(organisation=organisation, **fields)
+    _save_device(device, None)
+    return device
+
+
+def update_device(device: Device, **changes: Any) -> Device:
+    """Changes a device's DEVICE_FIELDS (is_active=False deactivates it); same checks."""
+    _reject_unknown_device_fields(changes)
+    for field, value in changes.items():
+        setattr(device, field, value)
+    _save_device(device, [*changes, "updated_at"])
+    return device
+
+
+def _save_device(device: Device, update_fields: list[str] | None) -> None:
+    device.full_clean()
+    try:
+        with transaction.atomic():
+            if device.cell:
+                ensure_cell(device.organisation, device.cell)
+            device.save(update_fields=update_fields)
+    except IntegrityError:
+        raise ValidationError(
+            {"name": f"The organisation already has a device named {device.name}."}
+        ) from None
+
+
+def _reject_unknown_device_fields(fields: dict[str, Any]) -> None:
+    unknown = set(fields) - set(DEVICE_FIELDS)
+    if unknown:
+        raise TypeError(f"Not editable on a device: {', '.join(sorted(unknown))}")
 
 
 # Credentials secrets -----------------------------------------------------------------

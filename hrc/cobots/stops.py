@@ -2,7 +2,8 @@
 
 STOP is a convenience, not a safety function: it pauses the programs of the
 cell's cobots (PauseProgram, what a space constraint's interruption sends)
-and holds their queues (Cobot.stopped_at: no job is leased meanwhile). It
+and holds their queues (Cobot.stopped_at: no job is leased meanwhile), and the
+queues of the cell's devices (no call starts while the cell's CellStop is active). It
 never powers anything off and never touches a protective or emergency stop;
 the robots' own safety systems stay in charge. Resuming needs an explicit
 confirmation and restarts only the programs that are paused and that no
@@ -27,7 +28,7 @@ from hrc.cobots import hooks
 from hrc.cobots.commands import outside_transaction
 from hrc.cobots.drivers.base import DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
-from hrc.cobots.models import CellStop, Cobot
+from hrc.cobots.models import CellStop, Cobot, Device
 from hrc.errors import Conflict
 from hrc.organisations.models import Organisation
 from hrc_gateway import urua
@@ -54,6 +55,9 @@ def stop_cell(organisation: Organisation, cell: str, *, by: User) -> CellStop:
         if existing is not None:
             return existing
         cobots = _cell_cobots(organisation, cell)
+        # A device's worker leases a call holding its device row: one that checked the cell
+        # before this STOP commits has started its call before the STOP, never after.
+        list(_cell_devices(organisation, cell))
         try:
             with transaction.atomic():
                 stop = CellStop.objects.create(
@@ -96,6 +100,7 @@ def resume_cell(organisation: Organisation, cell: str, *, by: User, confirmed: b
         for cobot in held:
             hooks.queue_changed(cobot.pk)
             hooks.queue_released(cobot.pk)  # the queue waited for the resume
+        hooks.devices_released([device.pk for device in _cell_devices(organisation, cell)])
     _record_problems(stop, {**stop.problems, **_command_all(held, _restart)})
     return stop
 
@@ -120,6 +125,12 @@ def _cell_cobots(organisation: Organisation, cell: str) -> list[Cobot]:
         Cobot.objects.select_for_update(no_key=True).filter(
             organisation=organisation, cell=cell, is_active=True
         )
+    )
+
+
+def _cell_devices(organisation: Organisation, cell: str) -> list[Device]:
+    return list(
+        Device.objects.select_for_update(no_key=True).filter(organisation=organisation, cell=cell)
     )
 
 

@@ -1,4 +1,5 @@
-"""The cobot pages for engineers and admins: /cobots/, /cobots/<id>/, new/ and <id>/edit/.
+"""The cobot pages for engineers and admins: /cobots/, /cobots/<id>/, new/ and <id>/edit/;
+and the device pages for admins: /cobots/devices/, devices/new/ and devices/<id>/edit/.
 
 Behind the organisation wall as the supervisor pages are: another
 organisation's cobot is a 404 whatever its id; in the organisation without
@@ -24,23 +25,27 @@ from django.views.decorators.http import require_http_methods
 
 from hrc.cobots import control, hooks, services
 from hrc.cobots.choices import ControlCommand
-from hrc.cobots.forms import CobotForm, CredentialsSecretForm
-from hrc.cobots.models import Cobot
+from hrc.cobots.forms import CobotForm, CredentialsSecretForm, DeviceForm
+from hrc.cobots.models import Cobot, Device
 from hrc.cobots.selectors import (
     cobots_visible_to,
     commands_of,
     credentials_secrets_of,
+    devices_of,
+    devices_visible_to,
     live_state,
 )
 from hrc.errors import NotAllowed
 from hrc.navigation import current_membership
 from hrc.organisations.choices import WRITER_ROLES, AdminAction, Role
-from hrc.organisations.selectors import may_write_in, writable_organisations
+from hrc.organisations.models import Membership
+from hrc.organisations.selectors import is_admin_of, may_write_in, writable_organisations
 from hrc.organisations.services import record_admin_action
 from hrc_gateway import urua
 
 ENGINEERS_ONLY = "Only engineers and admins of the organisation control its cobots."
 ADMINS_ONLY = "Only admins of the organisation set its cobots' credentials."
+DEVICE_ADMINS_ONLY = "Only admins of the organisation register, change or deactivate its devices."
 COMMANDS_PER_PAGE = 20
 # Seconds the list waits for each cobot's state; an unreachable one says so instead.
 LIST_STATE_TIMEOUT = 1.5
@@ -97,6 +102,7 @@ def cobot_detail(request: HttpRequest, pk: int) -> HttpResponse:
         "registers": registers,
         "problems": problems,
         "commands": commands,
+        "devices": _with_queues(list(cobot.devices.order_by("name"))),
         "buttons": [{"command": c, "path": p, "label": label} for c, p, label in BUTTONS],
         "script": _script(cobot),
     }
@@ -197,6 +203,66 @@ def credentials_secrets(request: HttpRequest) -> HttpResponse:
     }
     status = 400 if form.errors or problem else 200
     return render(request, "cobots/credentials.html", context, status=status)
+
+
+@login_required
+def device_list(request: HttpRequest) -> HttpResponse:
+    """The organisation's devices by cell, each with its queue (the running call first)."""
+    membership = _admin_membership(request)
+    devices = _with_queues(list(devices_of(membership.organisation_id)))
+    return render(request, "cobots/device_list.html", {"devices": devices})
+
+
+@require_http_methods(["GET", "POST"])
+@login_required
+def device_new(request: HttpRequest) -> HttpResponse:
+    """Registers a device of one of the organisation's cells, served by one of its cobots."""
+    membership = _admin_membership(request)
+    form = DeviceForm(request.POST or None, instance=Device(organisation=membership.organisation))
+    if request.method == "POST" and form.is_valid():
+        try:
+            services.create_device(membership.organisation, **form.cleaned_data)
+        except ValidationError as error:
+            form.add_service_errors(error)
+        else:
+            return HttpResponseRedirect(reverse("cobots:device-list"))
+    status = 400 if form.errors else 200
+    return render(request, "cobots/device_form.html", {"form": form, "device": None}, status=status)
+
+
+@require_http_methods(["GET", "POST"])
+@login_required
+def device_edit(request: HttpRequest, pk: int) -> HttpResponse:
+    """Changes a device; unticking "active" takes it out of service (its queue waits)."""
+    device = devices_visible_to(request.user).filter(pk=pk).first()
+    if device is None:
+        raise Http404("No such device.")
+    if not is_admin_of(request.user, device.organisation_id):
+        raise NotAllowed(DEVICE_ADMINS_ONLY)
+    form = DeviceForm(request.POST or None, instance=device)
+    if request.method == "POST" and form.is_valid():
+        try:
+            services.update_device(device, **{f: form.cleaned_data[f] for f in form.changed_data})
+        except ValidationError as error:
+            form.add_service_errors(error)
+        else:
+            return HttpResponseRedirect(reverse("cobots:device-list"))
+    status = 400 if form.errors else 200
+    return render(
+        request, "cobots/device_form.html", {"form": form, "device": device}, status=status
+    )
+
+
+def _admin_membership(request: HttpRequest) -> Membership:
+    membership = current_membership(request)
+    if membership is None or membership.role != Role.ADMIN:
+        raise NotAllowed(DEVICE_ADMINS_ONLY)
+    return membership
+
+
+def _with_queues(devices: list[Device]) -> list[dict[str, Any]]:
+    queues = hooks.device_queues([device.pk for device in devices])
+    return [{"device": device, "queue": queues[device.pk]} for device in devices]
 
 
 def _record(cobot: Cobot, by: Any, action: AdminAction, values: dict[str, Any]) -> None:

@@ -3,7 +3,8 @@
 An example whose file changed is published as the pattern's next version;
 an unchanged one is left alone. Each version without a default actor
 mapping gets one, so a case of any example can start at once: operators are
-the demo team, cobot actors the demo cobots in turn.
+the demo team, cobot actors the demo cobots in turn, device actors the floor's device of
+their kind.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from hrc.cases import services as case_services
 from hrc.cases.nets import case_net
 from hrc.cobots.models import Cobot
 from hrc.engine import FormatError
+from hrc.engine.taskconfig import device_kind_of
 from hrc.errors import Invalid
 from hrc.organisations.models import Organisation, Team
 from hrc.patterns import services as pattern_services
@@ -108,6 +110,8 @@ def map_actors(version: PatternVersion, team: Team, cobots: Sequence[Cobot]) -> 
     mapping: dict[str, dict[str, int]] = {}
     turn = 0
     for actor in case_net(version).pattern.actors:
+        if device_kind_of(actor) is not None:
+            continue  # the floor's only device of its kind (mapping.py's default)
         if actor.type == "cobot":
             mapping[actor.id] = {"cobot": cobots[turn % len(cobots)].pk}
             turn += 1

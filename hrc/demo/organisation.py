@@ -1,4 +1,5 @@
-"""The demo organisation: "Demo plant", one person per persona, a team and two simulated cobots.
+"""The demo organisation: "Demo plant", one person per persona, a team, two simulated cobots
+and the devices of the floor they stand on (one of each kind, served by cobot1's gateway).
 
 `manage.py load_demo`, `manage.py demo` and the browser test of the personas
 all provision through `provision`, so what the test signs in as is what a
@@ -17,7 +18,8 @@ from django.db import transaction
 
 from hrc.cobots import services as cobot_services
 from hrc.cobots.choices import DriverKind
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
+from hrc.engine.taskconfig import DEVICE_KINDS
 from hrc.organisations import services as organisation_services
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Membership, Organisation, Team
@@ -127,6 +129,8 @@ def provision(
         )
         for cobot in DEMO_COBOTS
     ]
+    for kind in DEVICE_KINDS:
+        _ensure_device(organisation, kind, gateway=cobots[0])
     return DemoOrganisation(organisation, users, passwords, team, cobots)
 
 
@@ -167,6 +171,17 @@ def _ensure_cobot(organisation: Organisation, name: str, endpoint: str, source: 
         if getattr(cobot, field) != value
     }  # fmt: skip
     return cobot_services.update_cobot(cobot, **changed) if changed else cobot
+
+
+def _ensure_device(organisation: Organisation, kind: str, *, gateway: Cobot) -> Device:
+    """The floor's device of `kind` (the demo cobots stand on the floor, in no cell), named
+    after its kind, on `gateway`'s simulator, which serves every kind under Devices/."""
+    settings = {"kind": kind, "cell": "", "gateway": gateway, "is_active": True}
+    device = organisation.devices.filter(name=kind).first()
+    if device is None:
+        return cobot_services.create_device(organisation, name=kind, **settings)
+    changed = {field: value for field, value in settings.items() if getattr(device, field) != value}
+    return cobot_services.update_device(device, **changed) if changed else device
 
 
 def credential_lines(demo: DemoOrganisation) -> list[str]:

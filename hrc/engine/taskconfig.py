@@ -29,6 +29,10 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
 Message correlation and send expressions read `case` (its `id` and
 `reference`) besides `data`: `=case.id` keeps a message inside its case.
 
+An actor may carry `"device": "<kind>"` (a cobot actor only): a device actor, whose lane holds
+device calls of that kind only (a linear axis beside the cobots); DEVICE_KINDS are the calls'
+prefixes.
+
 And the document itself may carry `"data"`: a JSON object every case's data
 starts with (the use case's settings: poses, spots, task lists); the data a
 case is started with is laid over it, key by key.
@@ -66,6 +70,10 @@ DEVICE_CALLS: Final[Mapping[str, tuple[str, tuple[str, ...], tuple[str, ...]]]] 
     "place-position.check": ("Devices/PlacePosition/Check", (), ("free",)),
     "place-position.wait": ("Devices/PlacePosition/WaitUntilFree", ("timeout_ms",), ("free",)),
 }
+
+# The kinds of device (a device actor's `"device"` key, a registered device's kind): the
+# calls' prefixes, "linear-axis" for "linear-axis.move".
+DEVICE_KINDS: Final = tuple(sorted({call.split(".")[0] for call in DEVICE_CALLS}))
 
 # How a space constraint interrupts the cobot (its "interrupt" key); pause by default.
 INTERRUPT_MODES: Final = ("pause", "slow")
@@ -150,6 +158,8 @@ def task_config(pattern: Pattern, transition: Transition) -> TaskConfig:
         return TaskConfig("operator", form=form, **common)
     if "step" in raw and "device" in raw:
         raise ConfigError(t, "a cobot task runs either a 'step' or a 'device' call, not both.")
+    if "device" in actor.extra:
+        return TaskConfig("device", device=_device_actor_call(t, raw, actor), **common)
     if "device" in raw:
         return TaskConfig("device", device=_device(t, raw["device"]), **common)
     actor_program = actor.extra.get("program")
@@ -250,6 +260,60 @@ def _device(t: str, raw: object) -> DeviceConfig:
     for name, value in args.items():
         _check_value(t, f"argument {name!r}", value)
     return DeviceConfig(call, args)
+
+
+def _device_actor_call(t: str, raw: Mapping[str, Any], actor: Actor) -> DeviceConfig:
+    """A task of a device actor's lane: a call of the actor's kind, nothing else."""
+    kind = device_kind_of(actor)
+    if kind is None:
+        raise ConfigError(
+            t, f"its actor {actor.id!r} has device {actor.extra['device']!r}; it must be one of "
+            f"{', '.join(DEVICE_KINDS)}.",
+        )  # fmt: skip
+    if "device" not in raw:
+        raise ConfigError(
+            t, f"the device actor {actor.id!r} runs device calls only: give the task a "
+            f"'device' call of {kind}.",
+        )  # fmt: skip
+    config = _device(t, raw["device"])
+    if config.call.split(".")[0] != kind:
+        raise ConfigError(
+            t, f"the device actor {actor.id!r} is a {kind}; it cannot run {config.call}.",
+        )  # fmt: skip
+    return config
+
+
+def _wrong_device_actor(actor: Actor) -> str:
+    if actor.type != "cobot":
+        return f"The actor {actor.id} is an {actor.type}; only a cobot actor is a device actor."
+    return (
+        f"The actor {actor.id} has device {actor.extra['device']!r}; it must be one of "
+        f"{', '.join(DEVICE_KINDS)}."
+    )
+
+
+def device_kind_of(actor: Actor) -> str | None:
+    """The kind of device a device actor stands for (its "device" key); None for another actor
+    or an unknown kind."""
+    kind = actor.extra.get("device")
+    return kind if actor.type == "cobot" and kind in DEVICE_KINDS else None
+
+
+def device_kinds_called(pattern: Pattern) -> dict[str, set[str]]:
+    """The kinds of device each cobot actor's lane calls (device actors left out: their lane is
+    their own device's); a task whose configuration is malformed calls none."""
+    called: dict[str, set[str]] = {}
+    for _, transition in pattern.transitions():
+        actor = pattern.actor(transition.performer or "")
+        if actor is None or actor.type != "cobot" or "device" in actor.extra:
+            continue
+        try:
+            config = task_config(pattern, transition)
+        except ConfigError:
+            continue
+        if config.device is not None:
+            called.setdefault(actor.id, set()).add(config.device.call.split(".")[0])
+    return called
 
 
 def _check_value(t: str, what: str, value: object, names: frozenset[str] = DATA_NAMES) -> None:
@@ -392,6 +456,9 @@ def config_issues(pattern: Pattern) -> list[Issue]:
         except ConfigError as problem:
             where = sentence(names.node(transition.id))
             issues.append(error("task-config", f"{where}: {problem.problem}", transition.id))
+    for actor in pattern.actors:
+        if "device" in actor.extra and device_kind_of(actor) is None:
+            issues.append(error("task-config", _wrong_device_actor(actor)))
     for constraint in pattern.constraints:
         modes = space_modes(pattern, constraint.source, constraint.target)
         mode = constraint.extra.get("interrupt", modes[0] if modes else "pause")

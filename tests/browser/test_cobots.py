@@ -12,7 +12,7 @@ import pytest
 from django.contrib.auth.models import User
 from playwright.sync_api import Page, expect
 
-from hrc.cobots.models import CobotCommand
+from hrc.cobots.models import CobotCommand, Device
 from hrc.cobots.simulated import GatewayProcess
 from hrc.organisations.models import Organisation
 from hrc_gateway import urua
@@ -83,3 +83,40 @@ def test_a_cancelled_confirmation_sends_nothing(
     page.wait_for_timeout(500)
     assert not CobotCommand.objects.exists()
     expect(page.locator("#commands tbody")).to_contain_text("No commands yet.")
+
+
+def test_an_admin_registers_a_device_of_a_cell_and_deactivates_it(
+    page: Page,
+    live_url: str,
+    sign_in: SignIn,
+    screenshot: Screenshot,
+    admin: User,
+    organisation: Organisation,
+    gateway: GatewayProcess,
+) -> None:
+    cobot = factories.make_cobot(organisation, name="cobot1", endpoint=gateway.endpoint, cell="A")
+    sign_in(page, admin)
+    page.goto(f"{live_url}/cobots/")
+    page.get_by_role("link", name="Devices").click()
+    page.get_by_role("link", name="Register a device").click()
+    page.get_by_label("Name").fill("axis1")
+    page.get_by_label("Kind").select_option("linear-axis")
+    page.get_by_label("Cell").select_option("A")
+    page.get_by_label("Gateway").select_option(str(cobot.pk))
+    page.get_by_role("button", name="Register the device").click()
+
+    row = page.locator("table.devices tbody tr", has_text="axis1")
+    expect(row).to_contain_text("Linear axis")
+    expect(row).to_contain_text("cobot1")
+    screenshot(page, "device-list")
+    device = Device.objects.get(organisation=organisation, name="axis1")
+    assert (device.kind, device.cell, device.gateway_id) == ("linear-axis", "A", cobot.pk)
+
+    row.get_by_role("link", name="axis1").click()
+    page.get_by_label("Active").uncheck()
+    page.get_by_role("button", name="Save").click()
+    expect(page.locator("table.devices tbody tr", has_text="axis1")).to_contain_text(
+        "out of service"
+    )
+    device.refresh_from_db()
+    assert device.is_active is False

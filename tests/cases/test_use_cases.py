@@ -104,8 +104,12 @@ def _write(simulation: Simulation, cobot: str, values: dict[str, str]) -> None:
 
 
 def _cobot_jobs(cases: list[Case]) -> Iterator[tuple[int, list[Job]]]:
-    """Each cobot's jobs of these cases (steps and device calls), in the order they ran."""
-    jobs = Job.objects.filter(case__in=cases).select_related("work_item").order_by("started_at")
+    """Each cobot's jobs of these cases, in the order they ran (device calls are their devices')."""
+    jobs = (
+        Job.objects.filter(case__in=cases, cobot__isnull=False)
+        .select_related("work_item")
+        .order_by("started_at")
+    )
     for cobot in sorted({job.cobot_id for job in jobs}):
         yield cobot, [job for job in jobs if job.cobot_id == cobot]
 
@@ -164,6 +168,10 @@ def test_spot_taping_tapes_four_harnesses_in_two_cycles_the_pedal_moving_the_axi
     assert pedals == moves == 9
     assert run.devices["cL"]["LinearAxis/Position"] == "left"
     assert run.devices["cR"]["LinearAxis/Position"] == "left"  # the right cell's axis: unused
+    # The axis is a device actor of its own lane: its moves wait in its queue, not a cobot's.
+    axis_moves = Job.objects.filter(case=case, work_item__task__startswith="tc_axis")
+    assert {(job.device.kind if job.device else None) for job in axis_moves} == {"linear-axis"}
+    assert not axis_moves.filter(cobot__isnull=False).exists()
 
 
 @pytest.mark.django_db(transaction=True)
@@ -209,8 +217,8 @@ def test_extended_spot_taping_queue_variant_shares_the_cobots_between_two_cases(
         assert (case.data["cycle"], case.data["harnesses"]) == (2, 4)
     # Operator 2's case: its own operator, the cobots swapped.
     assert first.actor_mapping["o"] != second.actor_mapping["o"]
-    assert first.actor_mapping["cL"] == second.actor_mapping["cR"]
-    assert first.actor_mapping["cR"] == second.actor_mapping["cL"]
+    assert first.actor_mapping["cL"]["cobot"] == second.actor_mapping["cR"]["cobot"]
+    assert first.actor_mapping["cR"]["cobot"] == second.actor_mapping["cL"]["cobot"]
     assert run.executions == {"cL": 8, "cR": 8}  # four spots for each operator on each cobot
     # Each operator's axis is their own left cobot's cell's.
     assert run.devices["cL"]["LinearAxis/Position"] == run.devices["cR"]["LinearAxis/Position"]
@@ -228,8 +236,8 @@ def test_extended_spot_taping_queue_variant_shares_the_cobots_between_two_cases(
     served: dict[int, list[int]] = {}
     for event in run.trace:
         cobot = cobot_of.get((event["case"], event["actor"]))
-        if cobot is None:
-            continue
+        if cobot is None or event["task"].startswith("tc_axis"):
+            continue  # an axis move runs in the axis's own queue, beside the cobot's steps
         if event["event"] == "task-started":
             assert running.get(cobot) is None, f"two tasks at once on cobot {cobot}: {event}"
             running[cobot] = (event["case"], event["task"])

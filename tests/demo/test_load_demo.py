@@ -10,7 +10,7 @@ from django.contrib.auth.models import User
 from django.core.management import CommandError, call_command
 
 from hrc.cases import services as case_services
-from hrc.cobots.models import Cobot
+from hrc.cobots.models import Cobot, Device
 from hrc.demo.library import example_files
 from hrc.demo.management.commands.load_demo import EXAMPLES_DIR
 from hrc.organisations.models import Membership, Organisation, Team
@@ -96,10 +96,13 @@ def test_every_example_can_start_a_case_with_the_demo_people_and_cobots() -> Non
     assert versions.exists()
     for version in versions:
         actors = {actor["id"]: actor["type"] for actor in version.document["actors"]}
+        device_actors = {a["id"] for a in version.document["actors"] if "device" in a}
         mapping = version.default_actor_mapping
         assert set(mapping) == set(actors), version
         for actor, kind in actors.items():
-            if kind == "cobot":
+            if actor in device_actors:
+                assert Device.objects.get(pk=mapping[actor]["device"]).organisation == organisation
+            elif kind == "cobot":
                 assert mapping[actor]["cobot"] in cobots
             else:
                 assert mapping[actor] == {"team": team.pk}

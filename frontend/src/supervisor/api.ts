@@ -4,7 +4,8 @@
 export type Marking = Record<string, number>;
 
 export interface JobJson {
-  cobot_name: string;
+  cobot_name: string | null;
+  device_name: string | null;
   state: string;
   queue_position: number | null;
   waiting_for: string;

@@ -168,7 +168,7 @@ export function workRow(item: WorkItemJson): WorkRow {
     task: item.task,
     label: item.label || item.task,
     state: item.state,
-    who: item.claimed_by || item.job?.cobot_name || "–",
+    who: item.claimed_by || item.job?.cobot_name || item.job?.device_name || "–",
     job: jobText(item.job),
     id: item.id,
     reassignable: item.kind === "operator" && OPEN_WORK_ITEM_STATES.has(item.state),

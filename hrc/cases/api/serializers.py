@@ -76,15 +76,21 @@ class _EnumFieldSchema(OpenApiSerializerFieldExtension):  # type: ignore[no-unty
 
 
 class JobSerializer(serializers.ModelSerializer[Job]):
-    """A command to a cobot: where it stands in the cobot's queue and what it waits for."""
+    """A command to a cobot or a device: where it stands in its queue and what it waits for."""
 
-    cobot_name = serializers.CharField(source="cobot.name", read_only=True)
+    cobot_name = serializers.CharField(
+        source="cobot.name", read_only=True, allow_null=True, help_text="null for a device's job."
+    )
+    device_name = serializers.CharField(
+        source="device.name", read_only=True, allow_null=True,
+        help_text="The device whose queue a device call waits in; null for a cobot's job.",
+    )  # fmt: skip
     kind = EnumField(WorkItemKind)
     state = EnumField(JobState)
     queue_position = serializers.IntegerField(
         read_only=True,
         allow_null=True,
-        help_text="0: on the cobot now; 1: next in line; …; null: no longer queued.",
+        help_text="0: on its cobot or device now; 1: next in line; …; null: no longer queued.",
     )
 
     class Meta:
@@ -93,6 +99,8 @@ class JobSerializer(serializers.ModelSerializer[Job]):
             "id",
             "cobot",
             "cobot_name",
+            "device",
+            "device_name",
             "kind",
             "state",
             "queue_position",
@@ -332,7 +340,7 @@ class StartCaseRequestSerializer(serializers.Serializer[dict[str, Any]]):
         child=serializers.DictField(),
         required=False,
         help_text="Overrides the version's default mapping per actor: {actor: {users: [...]} | "
-        "{team: id or name} | {cobot: id or name}}. Not for operators: they start with the defaults.",
+        "{team: id or name} | {cobot: id or name} | {device: id or name}}. Not for operators: they start with the defaults.",
     )
     reference = serializers.CharField(
         required=False,
@@ -440,7 +448,7 @@ class ActorMappingSerializer(serializers.Serializer[PatternVersion]):
         child=serializers.DictField(),
         source="default_actor_mapping",
         help_text="{actor: {users: [ids or usernames]} | {team: id or name} | "
-        "{cobot: id or name}}; stored with ids.",
+        "{cobot: id or name} | {device: id or name}}; stored with ids.",
     )
 
 

@@ -385,13 +385,16 @@ class IncidentViewSet(viewsets.ReadOnlyModelViewSet[Incident]):
 
 @extend_schema_view(
     list=extend_schema(
-        parameters=[OpenApiParameter("cobot", int, description="Only this cobot's queue.")]
+        parameters=[
+            OpenApiParameter("cobot", int, description="Only this cobot's queue."),
+            OpenApiParameter("device", int, description="Only this device's queue."),
+        ]
     ),
     retrieve=extend_schema(responses={200: QueuedJobSerializer, **REFUSED_404}),
 )
 class JobViewSet(viewsets.ReadOnlyModelViewSet[Job]):
-    """Cobot queues: queued and running jobs, per cobot the running one first, then first come
-    first served. A job by id in any state. Read-only."""
+    """Cobot and device queues: queued and running jobs, per cobot and per device the running
+    one first, then first come first served. A job by id in any state. Read-only."""
 
     serializer_class = QueuedJobSerializer
 
@@ -400,8 +403,11 @@ class JobViewSet(viewsets.ReadOnlyModelViewSet[Job]):
         if self.action != "list":
             return selectors.jobs_visible_to(user)
         cobot = _id_param(self.request, "cobot")
+        device = _id_param(self.request, "device")
         queues = selectors.cobot_queues(user)
-        return queues if cobot is None else queues.filter(cobot_id=cobot)
+        if cobot is not None:
+            queues = queues.filter(cobot_id=cobot)
+        return queues if device is None else queues.filter(device_id=device)
 
 
 # Messages ------------------------------------------------------------------------------

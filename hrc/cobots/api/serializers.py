@@ -2,9 +2,11 @@
 
 from typing import Any
 
+from django.db.models import QuerySet
 from rest_framework import serializers
 
-from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
+from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret, Device
+from hrc.cobots.selectors import cobots_visible_to
 from hrc.organisations.api.serializers import MemberOrganisationField
 
 
@@ -137,3 +139,37 @@ class SetCredentialsSecretSerializer(serializers.Serializer[dict[str, Any]]):
     password = serializers.CharField(
         max_length=1024, write_only=True, trim_whitespace=False, style={"input_type": "password"}
     )
+
+
+class VisibleCobotField(serializers.PrimaryKeyRelatedField[Cobot]):
+    """A cobot id among the requesting user's organisations'; any other id is 'does not exist'."""
+
+    def get_queryset(self) -> QuerySet[Cobot]:
+        request = self.context.get("request")
+        user = getattr(request, "user", None)
+        return cobots_visible_to(user) if user is not None else Cobot.objects.none()
+
+
+class DeviceSerializer(serializers.ModelSerializer[Device]):
+    organisation = MemberOrganisationField(
+        required=False,
+        help_text="Where the device belongs; may be left out by an admin of only one organisation.",
+    )
+    gateway = VisibleCobotField(
+        help_text="The id of the cobot whose OPC UA gateway serves the device (same organisation)."
+    )
+
+    class Meta:
+        model = Device
+        fields = ["id", "organisation", "name", "kind", "cell", "gateway", "is_active",
+                  "created_at", "updated_at"]  # fmt: skip
+        read_only_fields = ["id", "created_at", "updated_at"]
+        validators: list[object] = []  # the service checks the name, once the organisation is known
+
+    def validate_organisation(self, organisation: object) -> object:
+        if (
+            self.instance is not None
+            and getattr(organisation, "pk", None) != self.instance.organisation_id
+        ):
+            raise serializers.ValidationError("A device cannot move to another organisation.")
+        return organisation

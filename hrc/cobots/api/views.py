@@ -50,13 +50,14 @@ from hrc.cobots.api.serializers import (
     CommandRefusalSerializer,
     ControlRequestSerializer,
     CredentialsSecretSerializer,
+    DeviceSerializer,
     LoadProgramRequestSerializer,
     RegistersSerializer,
     SetCredentialsSecretSerializer,
 )
 from hrc.cobots.choices import ControlCommand
-from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret
-from hrc.cobots.selectors import cobots_visible_to, commands_of, live_state
+from hrc.cobots.models import Cobot, CobotCommand, CredentialsSecret, Device
+from hrc.cobots.selectors import cobots_visible_to, commands_of, devices_visible_to, live_state
 from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import is_admin_of, memberships_of, organisations_of
@@ -307,3 +308,42 @@ def _admin_organisation(request: Request, requested: int | None) -> Organisation
             {"organisation": "You are an admin of several organisations: say which one (its id)."}
         )
     return found[0]
+
+
+DEVICE_ADMINS_ONLY = "Only admins of the organisation register, change or deactivate its devices."
+
+
+class MembersReadAdminsWriteDevices(MembersReadAdminsWrite):
+    message = DEVICE_ADMINS_ONLY
+
+
+class DeviceViewSet(
+    mixins.ListModelMixin,
+    mixins.RetrieveModelMixin,
+    mixins.CreateModelMixin,
+    mixins.UpdateModelMixin,
+    viewsets.GenericViewSet[Device],
+):
+    """/api/devices/: the devices of your organisations' cells, each with a queue of its own.
+
+    Members read; admins of the organisation register, change and deactivate
+    (`is_active: false`) them. Another organisation's device is 404.
+    """
+
+    serializer_class = DeviceSerializer
+    permission_classes = [MembersReadAdminsWriteDevices]
+
+    def get_queryset(self) -> QuerySet[Device]:
+        return devices_visible_to(self.request.user).order_by("name", "id")
+
+    def perform_create(self, serializer: serializers.BaseSerializer[Device]) -> None:
+        fields = dict(serializer.validated_data)
+        requested = fields.pop("organisation", None)
+        organisation = _admin_organisation(self.request, getattr(requested, "pk", requested))
+        serializer.instance = services.create_device(organisation, **fields)
+
+    def perform_update(self, serializer: serializers.BaseSerializer[Device]) -> None:
+        assert serializer.instance is not None
+        changes = dict(serializer.validated_data)
+        changes.pop("organisation", None)  # validated to be unchanged
+        services.update_device(serializer.instance, **changes)

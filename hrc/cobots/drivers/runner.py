@@ -35,7 +35,7 @@ class _Loop:
         self._lock = threading.Lock()
         self._pid: int | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
-        self.drivers: dict[tuple[str, str, ClientSecurity | None], OpcUaDriver] = {}
+        self.drivers: dict[tuple[str, str, ClientSecurity | None, str], OpcUaDriver] = {}
 
     def loop(self) -> asyncio.AbstractEventLoop:
         with self._lock:
@@ -101,15 +101,21 @@ class SyncDriver:
 
 
 def driver_for(
-    name: str, endpoint: str, security: ClientSecurity | None = None, **options: Any
+    name: str,
+    endpoint: str,
+    security: ClientSecurity | None = None,
+    *,
+    session: str = "",
+    **options: Any,
 ) -> SyncDriver:
     """The process's driver for a cobot at an endpoint, created on first use.
 
     `options` (timeouts) apply when the driver is created; later calls get the same driver.
+    Another `session` ("devices") is a driver of its own, on a connection of its own.
     It connects only within settings.HRC_COBOT_NETWORKS when that is set.
     """
     options.setdefault("networks", settings.HRC_COBOT_NETWORKS)
-    key = (name, endpoint, security)
+    key = (name, endpoint, security, session)
     loop = _LOOP.loop()
     driver = _LOOP.drivers.get(key)
     if driver is None:

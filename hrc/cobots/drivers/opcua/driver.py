@@ -25,7 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from asyncua import Client, Node, ua
-from asyncua.common.methods import call_method_full
+from asyncua.common.methods import to_variant
+from asyncua.ua.ua_binary import struct_from_binary
 
 from hrc.cobots.drivers import readiness
 from hrc.cobots.drivers.base import (
@@ -651,9 +652,10 @@ class OpcUaDriver(CobotDriver):
             parent = self._client.get_node(f"ns={urua.NAMESPACE_INDEX};s={self.name}/{parent_path}")
         method_id = ua.NodeId.from_string(urua.node_id(self.name, method))
         self._cache_behind = True
+        limit = timeout or self.step_timeout
         try:
-            result = await asyncio.wait_for(
-                call_method_full(parent, method_id, *arguments), timeout or self.step_timeout
+            outputs = await asyncio.wait_for(
+                self._call_method(parent.nodeid, method_id, arguments, limit), limit
             )
         except ua.UaStatusCodeError as error:
             raise await self._refused(method, _status_name(error), method, method) from None
@@ -661,7 +663,30 @@ class OpcUaDriver(CobotDriver):
             raise StepTimeout(f"{self.name}: {method} did not return in time.") from None
         except _CONNECTION_ERRORS as error:
             raise self._unreachable(error) from None
-        return list(result.OutputArguments)
+        return outputs
+
+    async def _call_method(
+        self, parent: ua.NodeId, method: ua.NodeId, arguments: Sequence[Any], timeout: float
+    ) -> list[Any]:
+        """call_method_full with the call's own timeout: the session's request timeout
+        (request_timeout, a few seconds) would cut a long call short, a device's (a linear axis
+        moving for seconds) that the gateway answers only once it is done."""
+        assert self._client is not None
+        protocol = self._client.uaclient.protocol
+        if protocol is None:
+            raise ConnectionError("The session's connection is closed.")
+        to_call = ua.CallMethodRequest()
+        to_call.ObjectId, to_call.MethodId = parent, method
+        to_call.InputArguments = to_variant(*arguments)
+        request = ua.CallRequest()
+        request.Parameters.MethodsToCall = [to_call]
+        # The protocol writes the timeout into the request's header too: the gateway waits as long.
+        data = await protocol.send_request(request, timeout)
+        response = struct_from_binary(ua.CallResponse, data)
+        response.ResponseHeader.ServiceResult.check()
+        [result] = response.Results
+        result.StatusCode.check()
+        return [variant.Value for variant in result.OutputArguments or []]
 
     async def _refused(self, what: str, status: str, path: str, source: str) -> DriverError:
         """The error for a bad status, with the gateway's own explanation when it gave one.
