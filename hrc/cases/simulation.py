@@ -234,12 +234,15 @@ class Simulation:
         return {"cobot": self._cobots[stand_in].pk}
 
     def _device_for(self, stand_in: str, kind: str) -> Device:
-        """A device actor's device: the first cobot's cell's, as a cell's devices are served
-        beside its cobot (a gateway of its own when the pattern has no cobot)."""
+        """A device actor's device, served beside a cobot as a cell's devices are: the first
+        device actor of a kind gets the first cobot's cell's, the next the next cobot's (each
+        operator's own linear axis in the extended spot taping), cycling when actors outnumber
+        the cobots; a gateway of its own when the pattern has no cobot."""
         if not self._cobots:
             self._cobots[stand_in] = self._simulated_cobot(stand_in)
-        cobot = next(iter(self._cobots.values()))
-        return Device.objects.get(gateway=cobot, kind=kind)
+        taken = sum(device.kind == kind for device in self._devices.values())
+        cobots = list(self._cobots.values())
+        return Device.objects.get(gateway=cobots[taken % len(cobots)], kind=kind)
 
     def _member(self, username: str, role: str) -> User:
         user = User.objects.create_user(username)

@@ -200,6 +200,17 @@ def test_extended_spot_taping_two_processes_take_turns_on_the_cobots_told_by_mes
             assert before.ended_at is not None
             assert after.started_at is not None
             assert before.ended_at <= after.started_at, f"cobot {cobot}: {before.pk}, {after.pk}"
+    # Each operator's linear axis is a device of its own: its moves wait in its own queue.
+    axes = Job.objects.filter(case=case, device__isnull=False).select_related("work_item")
+    by_device = {
+        device: {job.work_item.task for job in axes if job.device_id == device}
+        for device in {job.device_id for job in axes}
+    }
+    assert sorted(by_device.values(), key=sorted) == [
+        {f"p1_axis_{k}" for k in range(5)},
+        {f"p2_axis_{k}" for k in range(5)},
+    ]
+    assert all(job.cobot_id is None for job in axes)
 
 
 @pytest.mark.django_db(transaction=True)
