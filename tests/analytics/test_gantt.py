@@ -200,7 +200,9 @@ def test_every_kind_of_interruption_is_marked_on_the_held_tasks_bar_naming_the_o
     bars = {b.bar.work_item: b for b in drawing.bars}
     refused, waited = drawing.marks
     assert (refused.y, waited.y) == (bars[3].y, bars[2].y)  # on the held task's row
-    assert refused.x < waited.x < bars[2].x  # from when it was kept out until it could start
+    started = bars[2].x
+    assert started is not None
+    assert refused.x < waited.x < started  # from when it was kept out until it could start
     assert (refused.word, waited.word) == ("refused", "waited")
     assert refused.title == "p refused: to1 label (o) in the shared area"
     assert waited.title == "c (ur5e-left) waited: to1 label (o) in the shared area"

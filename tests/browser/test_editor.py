@@ -682,10 +682,12 @@ def test_messages_a_transition_waits_for_and_a_task_sends_are_edited_as_json(
     def saved() -> bool:
         pattern.refresh_from_db()
         transitions = {t["id"]: t for t in pattern.draft["processes"][0]["transitions"]}
-        return transitions["t1"].get("message") == {
-            "name": "part-ready",
-            "correlation": {"order": "=data.order"},
-        } and transitions["tc3"].get("send") == {"name": "done", "payload": {"by": "cobot"}}
+        waits = transitions["t1"].get("message")
+        sends = transitions["tc3"].get("send")
+        return bool(
+            waits == {"name": "part-ready", "correlation": {"order": "=data.order"}}
+            and sends == {"name": "done", "payload": {"by": "cobot"}}
+        )
 
     until(saved)
 

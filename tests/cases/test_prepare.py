@@ -128,7 +128,8 @@ def test_a_powered_off_cobot_is_an_incident_at_once_that_names_it_and_the_remedy
         cobot = run.cobot("c")
         assert cobot.read(urua.STATE_ROBOT_MODE) == urua.ROBOT_MODE_POWER_OFF  # never by hrc
 
-    job = Job.objects.get(case_id=case_id)
+    job = Job.objects.select_related("cobot").get(case_id=case_id)
+    assert job.cobot is not None
     name = job.cobot.name
     assert took < job.timeout  # at once, not after the sweeper's lease expiries
     assert incident.kind == IncidentKind.STEP_FAILED
@@ -192,7 +193,8 @@ def test_a_protective_stop_before_a_step_is_an_incident_and_stays(tmp_path: Path
             time.sleep(1.0)  # hrc does nothing about the stop by itself
             assert cobot.read(urua.STATE_SAFETY_MODE) == "SAFETY_MODE_PROTECTIVE_STOP"
 
-    job = Job.objects.get(case_id=case_id)
+    job = Job.objects.select_related("cobot").get(case_id=case_id)
+    assert job.cobot is not None
     assert incident.message.startswith(f"{job.cobot.name} is in a protective stop")
     assert "hrc never clears it" in incident.message
     assert job.last_error == incident.message

@@ -151,7 +151,7 @@ TWO_COBOT_LANES = [[("tc1", "c1")], [("tc0", "c2"), ("tc2", "c2")]]
 
 
 def _overlap(one: dict[str, Any], other: dict[str, Any]) -> bool:
-    return one["started"] < other["ended"] and other["started"] < one["ended"]
+    return bool(one["started"] < other["ended"] and other["started"] < one["ended"])
 
 
 def test_two_cobots_sharing_an_area_never_run_their_steps_at_once(

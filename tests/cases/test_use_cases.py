@@ -110,7 +110,7 @@ def _cobot_jobs(cases: list[Case]) -> Iterator[tuple[int, list[Job]]]:
         .select_related("work_item")
         .order_by("started_at")
     )
-    for cobot in sorted({job.cobot_id for job in jobs}):
+    for cobot in sorted({job.cobot_id for job in jobs if job.cobot_id is not None}):
         yield cobot, [job for job in jobs if job.cobot_id == cobot]
 
 
