@@ -20,8 +20,6 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
-import os
-import socket
 from collections.abc import Iterable
 from typing import Any
 
@@ -30,7 +28,7 @@ from django.db import transaction
 from django.db.models import Exists, Q
 from django.utils import timezone
 
-from hrc.cases import dispatch, jobs, progress
+from hrc.cases import dispatch, jobs
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Job
@@ -134,32 +132,17 @@ def _lease_if_ready(
     device: Device, job_id: int, case_id: int, now: dt.datetime
 ) -> jobs.Lease | None:
     """Leases the call when its task may start now, else records why it waits."""
-    case = progress.lock_case(case_id)
-    job = (
-        Job.objects.select_for_update(of=("self",), no_key=True)
-        .select_related("work_item")
-        .get(pk=job_id)
-    )
+    case, job = jobs.lock_case_and_job(case_id, job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
     net = case_net(case.version)
-    waiting = ""
     if item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
-    if waiting:
-        if job.waiting_for != waiting:
-            job.waiting_for = waiting
-            job.save(update_fields=["waiting_for"])
-        return None
-    if item.state == WorkItemState.OFFERED:
-        progress.start_cobot_task(case, net, item)
-    job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
-    job.held_by = f"{socket.gethostname()}:{os.getpid()}"
-    job.started_at = job.started_at or now
-    job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
-    job.save(update_fields=jobs.LEASED_FIELDS)
-    case.save()
+        if waiting:
+            jobs.record_waiting(job, waiting)
+            return None
+    jobs.take_job(case, net, job, now)
     return jobs.Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout,
         device.gateway, sent_before=job.sent_at is not None, device=device,

@@ -190,7 +190,7 @@ def _lease_if_ready(
 ) -> Lease | None:
     """Leases the job when it may start now, else records why it waits; `held` is the queue
     statement's word that another case's func hold reserved the cobot (asked again here)."""
-    case, job = _lock_case_and_job(case_id, job_id)
+    case, job = lock_case_and_job(case_id, job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
@@ -203,19 +203,10 @@ def _lease_if_ready(
     if not waiting and item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
     if waiting:
-        if job.waiting_for != waiting:
-            job.waiting_for = waiting
-            job.save(update_fields=["waiting_for"])
+        if record_waiting(job, waiting):
             events.publish_cobot_queue(cobot.pk)
         return None
-    if item.state == WorkItemState.OFFERED:
-        progress.start_cobot_task(case, net, item)
-    job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
-    job.held_by = f"{socket.gethostname()}:{os.getpid()}"
-    job.started_at = job.started_at or now
-    job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
-    job.save(update_fields=LEASED_FIELDS)
-    case.save()
+    take_job(case, net, job, now)
     events.publish_cobot_queue(cobot.pk)
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
@@ -223,7 +214,7 @@ def _lease_if_ready(
     )  # fmt: skip
 
 
-def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
+def lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
     """Both rows locked, in the project's lock order (case, then job); the work item read along."""
     case = progress.lock_case(case_id)
     job = (
@@ -232,6 +223,29 @@ def _lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
         .get(pk=job_id)
     )
     return case, job
+
+
+def record_waiting(job: Job, waiting: str) -> bool:
+    """Says on the queued job why it waits; whether that changed (the queue's view then too)."""
+    if job.waiting_for == waiting:
+        return False
+    job.waiting_for = waiting
+    job.save(update_fields=["waiting_for"])
+    return True
+
+
+def take_job(case: Case, net: CaseNet, job: Job, now: dt.datetime) -> None:
+    """Leases the job to this worker, starting its task when it is only offered (the cobot or
+    device taking the job is the moment the task starts); saves the job and the case. Call
+    holding both locks, once nothing keeps the job waiting."""
+    if job.work_item.state == WorkItemState.OFFERED:
+        progress.start_cobot_task(case, net, job.work_item)
+    job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
+    job.held_by = f"{socket.gethostname()}:{os.getpid()}"
+    job.started_at = job.started_at or now
+    job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
+    job.save(update_fields=LEASED_FIELDS)
+    case.save()
 
 
 def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
@@ -459,7 +473,7 @@ def _backoff(retries_used: int) -> float:
 
 def _locked_job(lease: Lease) -> tuple[Case, Job | None]:
     """The case (locked) and the job, or None when this worker's lease is no longer the job's."""
-    case, job = _lock_case_and_job(lease.case_id, lease.job_id)
+    case, job = lock_case_and_job(lease.case_id, lease.job_id)
     if job.state != JobState.RUNNING or job.lease != lease.lease:
         logger.info("Job %s: lease %s was lost; its outcome is dropped", job.pk, lease.lease)
         return case, None
@@ -512,7 +526,7 @@ def _first_due_per_cobot(now: dt.datetime) -> list[int]:
 
 def _expire_lease(job_id: int, case_id: int) -> None:
     with transaction.atomic():
-        case, job = _lock_case_and_job(case_id, job_id)
+        case, job = lock_case_and_job(case_id, job_id)
         if (
             job.state != JobState.RUNNING
             or job.lease_expires_at is None
