@@ -15,17 +15,13 @@ from hrc.cobots.models import Cobot, Device
 from hrc.organisations.selectors import cells_of
 
 
-class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs makes it generic, Django does not
-    cell = forms.ChoiceField(
-        required=False,
-        help_text="The cell it stands in; its tablet shows and stops it. Add cells under Organisation → Cells.",
-    )
+class _InACellForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs makes it generic, Django does not
+    """A cobot or a device: named once in its organisation, standing in one of its cells (or on
+    the whole floor); `what` names it in the refusal of a taken name."""
 
-    class Meta:
-        model = Cobot
-        fields = ["name", "driver", "endpoint", "credentials_source", "cell", "is_active"]
+    what = ""
 
-    def __init__(self, data: Any = None, *, instance: Cobot) -> None:
+    def __init__(self, data: Any = None, *, instance: Cobot | Device) -> None:
         super().__init__(data, instance=instance)
         names = list(cells_of(instance.organisation_id).values_list("name", flat=True))
         if instance.cell and instance.cell not in names:
@@ -36,13 +32,26 @@ class CobotForm(forms.ModelForm):  # type: ignore[type-arg]  # django-stubs make
 
     def clean_name(self) -> str:
         name: str = self.cleaned_data["name"]
-        taken = Cobot.objects.filter(organisation_id=self.instance.organisation_id, name=name)
+        model = type(self.instance)
+        taken = model.objects.filter(organisation_id=self.instance.organisation_id, name=name)
         if taken.exclude(pk=self.instance.pk).exists():
-            raise ValidationError(f"The organisation already has a cobot named {name}.")
+            raise ValidationError(f"The organisation already has a {self.what} named {name}.")
         return name
 
     def add_service_errors(self, error: ValidationError) -> None:
         add_service_errors(self, error)
+
+
+class CobotForm(_InACellForm):
+    what = "cobot"
+    cell = forms.ChoiceField(
+        required=False,
+        help_text="The cell it stands in; its tablet shows and stops it. Add cells under Organisation → Cells.",
+    )
+
+    class Meta:
+        model = Cobot
+        fields = ["name", "driver", "endpoint", "credentials_source", "cell", "is_active"]
 
 
 class CredentialsSecretForm(forms.Form):
@@ -68,9 +77,11 @@ class CredentialsSecretForm(forms.Form):
             self.add_error(field if field in self.fields else None, messages)
 
 
-class DeviceForm(forms.ModelForm):  # type: ignore[type-arg]  # as CobotForm
+class DeviceForm(_InACellForm):
     """Registers or edits a device: its cell among the organisation's, its gateway among the
     organisation's cobots (another's is "not one of the choices")."""
+
+    what = "device"
 
     cell = forms.ChoiceField(
         required=False,
@@ -83,25 +94,9 @@ class DeviceForm(forms.ModelForm):  # type: ignore[type-arg]  # as CobotForm
 
     def __init__(self, data: Any = None, *, instance: Device) -> None:
         super().__init__(data, instance=instance)
-        names = list(cells_of(instance.organisation_id).values_list("name", flat=True))
-        if instance.cell and instance.cell not in names:
-            names.append(instance.cell)
-        cell = self.fields["cell"]
-        assert isinstance(cell, forms.ChoiceField)
-        cell.choices = [("", "– the whole floor –"), *((name, name) for name in names)]
         gateway = self.fields["gateway"]
         assert isinstance(gateway, forms.ModelChoiceField)
         gateway.queryset = Cobot.objects.filter(organisation_id=instance.organisation_id)
-
-    def clean_name(self) -> str:
-        name: str = self.cleaned_data["name"]
-        taken = Device.objects.filter(organisation_id=self.instance.organisation_id, name=name)
-        if taken.exclude(pk=self.instance.pk).exists():
-            raise ValidationError(f"The organisation already has a device named {name}.")
-        return name
-
-    def add_service_errors(self, error: ValidationError) -> None:
-        add_service_errors(self, error)
 
 
 def add_service_errors(form: forms.BaseForm, error: ValidationError) -> None:
