@@ -427,6 +427,16 @@ def space_modes(pattern: Pattern, first: str, second: str) -> tuple[str, ...]:
     return SPACE_MODES.get((kinds[0], kinds[1]), ()) if len(kinds) == 2 else ()
 
 
+def _device_end(pattern: Pattern, tasks: list[str]) -> str | None:
+    """The device actor performing one of `tasks`, if one does."""
+    for task in tasks:
+        transition = pattern.transition(task)
+        actor = pattern.actor(transition.performer or "") if transition else None
+        if actor is not None and "device" in actor.extra:
+            return actor.id
+    return None
+
+
 def config_issues(pattern: Pattern) -> list[Issue]:
     """Every malformed task, guard or message configuration, as `task-config` errors."""
     issues = []
@@ -460,6 +470,20 @@ def config_issues(pattern: Pattern) -> list[Issue]:
         if "device" in actor.extra and device_kind_of(actor) is None:
             issues.append(error("task-config", _wrong_device_actor(actor)))
     for constraint in pattern.constraints:
+        if constraint.type == "space" and (device := _device_end(pattern, constraint.elements)):
+            # A call cannot be paused or slowed, and a space constraint does not hold one back.
+            issues.append(
+                error(
+                    "task-config",
+                    f"The space constraint {names.name(constraint.source)} → "
+                    f"{names.name(constraint.target)} ends at a call of the device actor "
+                    f"{device!r}: a device call is neither paused nor kept waiting for a shared "
+                    "area. Order it with a time constraint instead.",
+                    constraint.source,
+                    constraint.target,
+                )
+            )
+            continue
         modes = space_modes(pattern, constraint.source, constraint.target)
         mode = constraint.extra.get("interrupt", modes[0] if modes else "pause")
         if constraint.type == "space" and modes and mode not in modes:

@@ -75,3 +75,18 @@ def test_a_device_actors_lane_refuses_anything_but_a_call_of_its_kind(
 def test_an_unknown_device_kind_is_a_task_config_error_naming_the_kinds() -> None:
     errors = _task_config_errors(_doc(MOVE, device="teleporter"))
     assert any("'teleporter'" in error and "linear-axis" in error for error in errors)
+
+
+def test_a_space_constraint_on_a_device_call_is_refused_for_a_time_constraint() -> None:
+    data = _doc(MOVE)
+    data["constraints"] = [{"from": "tc1", "to": "ta1", "type": "space"}]
+
+    report = check_document(data)
+    [issue] = [i for i in report.errors if i.code == "task-config"]
+
+    assert set(issue.elements) == {"tc1", "ta1"}
+    assert "device actor 'axis'" in issue.message
+    assert "time constraint" in issue.message
+    # Ordered by time instead, the same two tasks check clean.
+    data["constraints"] = [{"from": "tc1", "to": "ta1", "type": "time"}]
+    assert _task_config_errors(data) == []
