@@ -80,6 +80,10 @@ class Gateway:
         self.space = AddressSpace(self.server, name)
         self._writes_to_pass_on: Callable[..., Awaitable[list[ua.StatusCode]]] | None = None
         self._heartbeat: asyncio.Task[None] | None = None
+        # The method LastError names: only its own success clears it. Clients on two sessions
+        # (a cobot's steps, its cell's device calls) call at once, and the one refused reads
+        # LastError for why after its answer: another's success must not wipe it meanwhile.
+        self._last_error_of = ""
 
     @property
     def endpoint(self) -> str:
@@ -255,13 +259,16 @@ class Gateway:
                 return await self._failed(
                     what, "The gateway failed unexpectedly; see its log.", "BadInternalError"
                 )
-            await self.space.publish({urua.STATE_LAST_ERROR: ""})
+            if self._last_error_of == what:
+                self._last_error_of = ""
+                await self.space.publish({urua.STATE_LAST_ERROR: ""})
             return [ua.Variant(v) for v in outputs]
 
         return call
 
     async def _failed(self, what: str, message: str, status: str) -> ua.StatusCode:
         logger.warning("%s on %s refused (%s): %s", what, self.name, status, message)
+        self._last_error_of = what
         await self.space.publish({urua.STATE_LAST_ERROR: f"{what}: {message}"})
         return ua.StatusCode(getattr(ua.StatusCodes, status))
 

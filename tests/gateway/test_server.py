@@ -122,6 +122,21 @@ async def test_a_failed_command_answers_bad_with_a_message(client: Client) -> No
         await root.call_method("2:SelectProgram", ua.Variant(3, ua.VariantType.Int32))
 
 
+async def test_last_error_is_cleared_by_its_own_commands_success_not_by_anothers(
+    client: Client,
+) -> None:
+    # A device call refused on one session while the cobot's commands succeed on another: the
+    # refused caller reads LastError for why after its answer, so no other success may wipe it.
+    root = node(client, "ns=2;s=cobot1")
+    last_error = node(client, "ns=2;s=/cobot1/State/LastError")
+    with pytest.raises(ua.UaStatusCodeError, match="BadNotFound"):
+        await root.call_method("2:SelectProgram", "NoSuchProgram")
+    await root.call_method("2:PowerOn")
+    assert "NoSuchProgram" in await last_error.read_value()
+    await root.call_method("2:SelectProgram", "Collaboration_Fixture")
+    assert await last_error.read_value() == ""
+
+
 async def test_brake_release_is_a_method_of_its_own_that_powering_on_does_not_need(
     client: Client,
 ) -> None:
