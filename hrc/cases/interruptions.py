@@ -83,13 +83,19 @@ def set_speed_before_step(cobot_id: int) -> bool:
     restored after the slowdowns that ended, then slowed for those still open (a step that
     starts beside an operator); whether none is left unsent (another sender may hold one)."""
     slowdowns = Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.SLOW)
-    restores = slowdowns.filter(ended_at__isnull=False, resumed_at__isnull=True)
-    for interruption_id in restores.values_list("pk", flat=True):
-        resume_cobot(interruption_id)
-    pending = slowdowns.filter(ended_at__isnull=True, paused_at__isnull=True)
-    for interruption_id in pending.values_list("pk", flat=True):
-        interrupt_cobot(interruption_id)
-    return not restores.exists() and not pending.exists()
+    restores = Q(ended_at__isnull=False, resumed_at__isnull=True)
+    pending = Q(ended_at__isnull=True, paused_at__isnull=True)
+    # One statement for the common case, a step with no slowdown to set: it is on every step.
+    due = list(slowdowns.filter(restores | pending).values_list("pk", "ended_at"))
+    if not due:
+        return True
+    # The restores first, then the slowdowns still open: a step beside an operator goes slowly.
+    for interruption_id, ended_at in sorted(due, key=lambda row: row[1] is None):
+        if ended_at is not None:
+            resume_cobot(interruption_id)
+        else:
+            interrupt_cobot(interruption_id)
+    return not slowdowns.filter(restores | pending).exists()
 
 
 def _claim(interruption_id: int, due: Q) -> tuple[Interruption, Cobot] | None:
