@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 from django.contrib.auth.models import User
-from playwright.sync_api import FilePayload, Page, expect
+from playwright.sync_api import FilePayload, Locator, Page, expect
 
 from hrc.engine.taskconfig import DEVICE_CALLS
 from hrc.organisations.models import Organisation
@@ -257,6 +257,13 @@ def test_a_second_constraint_type_on_one_pair_is_marked_on_its_tasks_and_lines(
     # The other constraint (tc3 → to2) is not part of it.
     expect(page.locator(".djs-connection .hrc-constraint")).to_have_count(3)
     screenshot(page, "editor-constraint-conflict")
+
+
+def _commit(panel: Locator, label: str, value: str) -> None:
+    """Types `value` into the properties panel's field `label` and leaves it, which commits it."""
+    field = panel.get_by_label(label, exact=True)
+    field.fill(value)
+    field.press("Tab")
 
 
 def _assembly(organisation: Organisation) -> PatternModel:
@@ -585,20 +592,15 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
     open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     panel = page.get_by_role("region", name="Properties")
 
-    def commit(label: str, value: str) -> None:
-        field = panel.get_by_label(label, exact=True)
-        field.fill(value)
-        field.press("Tab")
-
     select_element(page, "tc2")
     expect(panel.get_by_role("heading", name="Cobot task")).to_be_visible()
-    commit("Instructions", "Place the insert in the fixture.")
+    _commit(panel, "Instructions", "Place the insert in the fixture.")
     panel.get_by_label("Program", exact=True).fill("Assembly")
     panel.get_by_label("Program", exact=True).press("Tab")
-    commit("Step number", "4")
-    commit("Workspace", "=data.station")
-    commit("Pose list", "0.1, 0.2, 0.05, 0, 3.14, 0\n=data.insert_pose")
-    commit("Step number", "-2")
+    _commit(panel, "Step number", "4")
+    _commit(panel, "Workspace", "=data.station")
+    _commit(panel, "Pose list", "0.1, 0.2, 0.05, 0, 3.14, 0\n=data.insert_pose")
+    _commit(panel, "Step number", "-2")
     expect(
         panel.get_by_role("alert").filter(
             has_text="The step's number must be a whole number ≥ 0 or an expression starting with ="
@@ -611,18 +613,18 @@ def test_task_properties_are_edited_beside_the_canvas_and_saved_in_the_draft(
     # The calls offered are the engine's (taskconfig.DEVICE_CALLS), passed by the page.
     expect(panel.get_by_label("Device call").locator("option")).to_have_count(len(DEVICE_CALLS))
     panel.get_by_label("Device call").select_option("display.show")
-    commit("Argument text", "=data.message")
+    _commit(panel, "Argument text", "=data.message")
 
     select_element(page, "to2")
     expect(panel.get_by_role("heading", name="Operator task")).to_be_visible()
     panel.get_by_role("button", name="Add a form field").click()
-    commit("Name", "insert_ok")
-    commit("Title", "Insert seated")
+    _commit(panel, "Name", "insert_ok")
+    _commit(panel, "Title", "Insert seated")
     panel.get_by_label("Type").select_option("boolean")
     panel.get_by_label("required").check()
 
     select_element(page, "p1")
-    commit("Label", "workpiece arrives")
+    _commit(panel, "Label", "workpiece arrives")
     page.get_by_role("button", name="Save", exact=True).click()
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text("Saved.", timeout=CHECKED)
 
@@ -665,18 +667,19 @@ def test_messages_a_transition_waits_for_and_a_task_sends_are_edited_as_json(
     open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
     panel = page.get_by_role("region", name="Properties")
 
-    def commit(label: str, value: str) -> None:
-        field = panel.get_by_label(label, exact=True)
-        field.fill(value)
-        field.press("Tab")
-
     select_element(page, "t1")
     expect(panel.get_by_role("heading", name="Silent transition")).to_be_visible()
-    commit("Waits for a message", '{"name": "part-ready"')
+    _commit(panel, "Waits for a message", '{"name": "part-ready"')
     expect(panel.get_by_role("alert").filter(has_text="Not JSON")).to_be_visible()
-    commit("Waits for a message", '{"name": "part-ready", "correlation": {"order": "=data.order"}}')
+    _commit(
+        panel,
+        "Waits for a message",
+        '{"name": "part-ready", "correlation": {"order": "=data.order"}}',
+    )
     select_element(page, "tc3")
-    commit("Sends a message when it completes", '{"name": "done", "payload": {"by": "cobot"}}')
+    _commit(
+        panel, "Sends a message when it completes", '{"name": "done", "payload": {"by": "cobot"}}'
+    )
     page.get_by_role("button", name="Save").click()
 
     def saved() -> bool:
