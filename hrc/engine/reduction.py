@@ -18,6 +18,11 @@ from every marking, proper completion, boundedness, and which transitions
 can fire. Every reduced transition remembers the original firings it stands
 for, so a witness found in the reduced net expands into a firing sequence of
 the original.
+
+Reset arcs (`cancels`) are kept: a producer h keeps its resets, which happen
+before t's tokens arrive as they would have; and no place is agglomerated
+that a reset can empty, or whose consumer resets or feeds a place a reset
+can empty, since firing t earlier would then change what the reset removes.
 """
 
 from collections import defaultdict
@@ -31,6 +36,7 @@ class _Transition:
     pre: dict[str, int]
     post: dict[str, int]
     firings: list[str]
+    resets: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -39,6 +45,8 @@ class ReducedTransition:
     post: tuple[tuple[str, int], ...]
     firings: tuple[str, ...]
     """The original transitions' ids, in an order in which they can fire."""
+    resets: tuple[str, ...] = ()
+    """The places it empties after taking `pre`, before putting `post`."""
 
 
 @dataclass(frozen=True)
@@ -58,9 +66,14 @@ def reduce_net(net: Net) -> ReducedNet:
     something (so tokens piling up in p still show as unboundedness).
     Under these, any firing sequence of the original can be reordered to fire
     t right after the h that marked p: firing t earlier only adds tokens
-    sooner and takes none that another transition needed.
+    sooner and takes none that another transition needed. With reset arcs,
+    also: no transition resets p or a place t produces into, and t resets
+    nothing, so t commutes with every other firing.
     """
-    transitions = {t.id: _Transition(dict(t.pre), dict(t.post), [t.id]) for t in net.transitions}
+    transitions = {
+        t.id: _Transition(dict(t.pre), dict(t.post), [t.id], t.resets) for t in net.transitions
+    }
+    reset = {place for t in net.transitions for place in t.resets}
     producers: dict[str, set[str]] = defaultdict(set)
     consumers: dict[str, set[str]] = defaultdict(set)
     for tid, transition in transitions.items():
@@ -68,7 +81,7 @@ def reduce_net(net: Net) -> ReducedNet:
             consumers[place].add(tid)
         for place in transition.post:
             producers[place].add(tid)
-    protected = set(net.initial) | set(net.final)
+    protected = set(net.initial) | set(net.final) | reset
     places = list(net.places)
     worklist = list(reversed(places))
     removed: set[str] = set()
@@ -81,6 +94,8 @@ def reduce_net(net: Net) -> ReducedNet:
         (tid,) = consumers[place]
         consumer = transitions[tid]
         if consumer.pre != {place: 1} or place in consumer.post or not consumer.post:
+            continue
+        if consumer.resets or not reset.isdisjoint(consumer.post):
             continue
         if tid in producers[place]:
             continue
@@ -103,7 +118,10 @@ def reduce_net(net: Net) -> ReducedNet:
         places=kept,
         transitions=tuple(
             ReducedTransition(
-                tuple(sorted(t.pre.items())), tuple(sorted(t.post.items())), tuple(t.firings)
+                tuple(sorted(t.pre.items())),
+                tuple(sorted(t.post.items())),
+                tuple(t.firings),
+                t.resets,
             )
             for t in transitions.values()
         ),
