@@ -305,15 +305,17 @@ def _to_rewrite(pattern: Pattern, names: Names) -> Iterable[Issue]:
     """A `rewrite` note marks what an importer could not say in hrc's terms (a condition in
     another expression language, a loop without a condition): the model cannot run as meant."""
     for process in pattern.processes:
-        for node in (*process.places, *process.transitions):
-            if "rewrite" not in node.extra:
+        notes = [(p.id, p.extra) for p in process.places]
+        notes += [(t.id, t.extra) for t in process.transitions]
+        for node, extra in notes:
+            if "rewrite" not in extra:
                 continue
-            note = node.extra["rewrite"]
+            note = extra["rewrite"]
             what = note.strip().rstrip(".") if isinstance(note, str) else ""
             yield error(
                 "to-rewrite",
-                f"{sentence(names.node(node.id))} needs rewriting"
+                f"{sentence(names.node(node))} needs rewriting"
                 + (f": {what}. " if what else ". ")
                 + "Rewrite it in hrc's terms, then remove its 'rewrite' key.",
-                node.id,
+                node,
             )

@@ -429,9 +429,12 @@ def parse_duration(text: str) -> int:
             f"{text!r} is not an ISO 8601 duration such as PT5M (5 minutes), PT30S or P1DT2H."
         )
     total = sum(
-        Decimal(part.replace(",", ".")) * unit
-        for part, unit in zip(match.groups(), _MILLISECONDS, strict=True)
-        if part is not None
+        (
+            Decimal(part.replace(",", ".")) * unit
+            for part, unit in zip(match.groups(), _MILLISECONDS, strict=True)
+            if part is not None
+        ),
+        Decimal(0),
     )
     if total > MAX_TIMER_MS:
         raise ValueError(f"{text!r} is longer than a year; a timer waits at most P366D.")
