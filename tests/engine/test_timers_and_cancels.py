@@ -12,6 +12,7 @@ from hrc.engine.petri import Marking, Net, NetTransition
 from hrc.engine.reduction import reduce_net
 from hrc.engine.runtime import CaseNet, NotEnabled
 from hrc.engine.tokengame import execution_net_json
+from hrc.engine.wording import Names
 from tests.engine.builders import document, process
 
 Doc = dict[str, Any]
@@ -207,7 +208,10 @@ def test_a_timer_is_judged_as_any_silent_transition() -> None:
     for data, verdict in ((sound, True), (unsound, False)):
         timed, plain = check_document(data), check_document(_without(data, "timer"))
         assert timed.sound is verdict, timed.as_dict()
-        assert timed.as_dict() == plain.as_dict()
+        # The same findings; only the words differ ("timer xt rings" for "split/join xt fires").
+        assert [(e.code, e.elements, e.witness) for e in timed.errors] == [
+            (e.code, e.elements, e.witness) for e in plain.errors
+        ]
 
 
 def test_a_terminate_that_cancels_the_running_branch_is_sound() -> None:
@@ -238,8 +242,8 @@ def test_a_witness_through_a_cancel_replays_and_names_what_it_missed() -> None:
     assert improper.witness == ("xf", "start ta", "complete ta", "xt", "xto")
     assert improper.message == (
         "The case can end with work left over: after split/join xf fires, task ta starts, "
-        "task ta completes, split/join xt fires, split/join xto fires, the end place has its "
-        "token while place pd still holds one."
+        "task ta completes, timer xt rings and cancels task ta and place pt, split/join xto "
+        "fires, the end place has its token while place pd still holds one."
     )
     by_label = {t.label: t for t in net.transitions}
     marking = net.initial
@@ -296,3 +300,14 @@ def test_the_token_game_gets_the_resets() -> None:
 
     assert resets["xt"] == ["running:ta", "pt", "pd"]
     assert resets["start:ta"] == []
+
+
+def test_a_firing_sequence_says_a_timer_rings_and_what_a_step_cancels() -> None:
+    terminate = Names(read_pattern(_terminate(cancels=True)))
+    timed = Names(read_pattern(_guarded_task(["ta"])))
+
+    assert timed.firing("silent", "xt") == "timer xt rings and cancels task ta"
+    assert timed.firing("silent", "xto") == "split/join xto fires"
+    assert terminate.firing("silent", "xend") == (
+        "split/join xend fires and cancels place p1, place p2, place p3 and 12 more"
+    )
