@@ -14,7 +14,9 @@ extra places (pattern-format.md, "Execution semantics"):
   cobot while both run.
 
 A silent transition with `cancels` resets what it names when it fires: a
-place is emptied, a task's `running:t` too (the task is cancelled).
+place is emptied, a task's `running:t` too (the task is cancelled), and with
+it the func constraint places that stand for that run of t: `func-start:t>d`
+(t runs, so d may start) and `func-done:d>t` (d completed, for t to complete).
 
 Call it only on a pattern whose rules hold (`rules.check_rules` found nothing
 structural): it assumes every arc, performer and constraint end exists.
@@ -129,10 +131,16 @@ def build_execution_net(pattern: Pattern) -> Net:
             pre[f"complete:{t}"] = [(running, 1)]
             post[f"complete:{t}"] = list(outputs[t])
     ignored = constraint_places(pattern)
+    run_of: dict[str, list[str]] = defaultdict(list)  # task -> func places of its current run
     for place, constraint in ignored.items():
         places.append(place)
         post[constraint.producer].append((place, 1))
         pre[constraint.consumer].append((place, 1))
+        if constraint.kind != "time":
+            supporter = constraint.first if constraint.kind == "func-start" else constraint.second
+            run_of[f"running:{supporter}"].append(place)
+    for t, emptied in resets.items():
+        resets[t] = tuple(p for place in emptied for p in (place, *run_of.get(place, ())))
     return Net(
         places=tuple(dict.fromkeys(places)),
         transitions=tuple(

@@ -183,6 +183,37 @@ def test_the_execution_net_resets_the_running_place_of_a_cancelled_task() -> Non
     assert {t: r for t, r in resets.items() if r} == {"xt": ("running:ta", "pt", "pd")}
 
 
+def test_cancelling_a_supporter_withdraws_its_support_too() -> None:
+    # ta (the cobot's) supports to (func): while ta runs, to may start; cancelled, it no longer may.
+    data = _guarded_task(["ta", "pt", "pd", "po", "pq", "to"])
+    net = data["processes"][0]
+    net["places"] += [{"id": "po"}, {"id": "pq"}]
+    net["transitions"].append({"id": "to", "performer": "o"})
+    net["arcs"] += [["xf", "po"], ["po", "to"], ["to", "pq"], ["pq", "xok"]]
+    net["actors"].append("o")
+    data["actors"].append({"id": "o", "type": "operator"})
+    data["constraints"] = [{"from": "ta", "to": "to", "type": "func"}]
+    case = CaseNet(read_pattern(data))
+    marking, _ = case.settle(case.initial, {})
+    running = case.start(marking, "ta")
+    assert case.can_start(running, "to")
+
+    rung = case.ring(running, "xt")
+
+    assert case.transition("xt").resets == (
+        "running:ta",
+        "func-start:ta>to",
+        "func-done:to>ta",
+        "pt",
+        "pd",
+        "po",
+        "pq",
+        "running:to",
+    )
+    assert rung.get("func-start:ta>to") == 0
+    assert check_document(data).sound is True
+
+
 def test_a_reset_empties_a_place_whatever_it_holds_before_the_outputs_arrive() -> None:
     t = NetTransition("x", "x", "silent", (("a", 1),), (("b", 1),), resets=("b", "c"))
 
