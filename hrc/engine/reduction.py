@@ -20,9 +20,12 @@ for, so a witness found in the reduced net expands into a firing sequence of
 the original.
 
 Reset arcs (`cancels`) are kept: a producer h keeps its resets, which happen
-before t's tokens arrive as they would have; and no place is agglomerated
-that a reset can empty, or whose consumer resets or feeds a place a reset
-can empty, since firing t earlier would then change what the reset removes.
+before t's tokens arrive as they would have. A reset region must take p and
+t's outputs together or leave them all alone: then emptying the region
+gives the same marking whether t fired already or not (a terminate that
+empties its whole process keeps the process' chains reducible), while a
+region with p in it and t's outputs outside would have t move tokens out of
+its reach.
 """
 
 from collections import defaultdict
@@ -67,13 +70,14 @@ def reduce_net(net: Net) -> ReducedNet:
     Under these, any firing sequence of the original can be reordered to fire
     t right after the h that marked p: firing t earlier only adds tokens
     sooner and takes none that another transition needed. With reset arcs,
-    also: no transition resets p or a place t produces into, and t resets
-    nothing, so t commutes with every other firing.
+    also: t resets nothing, and each transition's resets hold either p and
+    every place t produces into, or none of them; so firing t earlier either
+    commutes with a reset or is undone by it exactly.
     """
     transitions = {
         t.id: _Transition(dict(t.pre), dict(t.post), [t.id], t.resets) for t in net.transitions
     }
-    reset = {place for t in net.transitions for place in t.resets}
+    regions = {frozenset(t.resets) for t in net.transitions if t.resets}
     producers: dict[str, set[str]] = defaultdict(set)
     consumers: dict[str, set[str]] = defaultdict(set)
     for tid, transition in transitions.items():
@@ -81,7 +85,7 @@ def reduce_net(net: Net) -> ReducedNet:
             consumers[place].add(tid)
         for place in transition.post:
             producers[place].add(tid)
-    protected = set(net.initial) | set(net.final) | reset
+    protected = set(net.initial) | set(net.final)
     places = list(net.places)
     worklist = list(reversed(places))
     removed: set[str] = set()
@@ -95,7 +99,7 @@ def reduce_net(net: Net) -> ReducedNet:
         consumer = transitions[tid]
         if consumer.pre != {place: 1} or place in consumer.post or not consumer.post:
             continue
-        if consumer.resets or not reset.isdisjoint(consumer.post):
+        if consumer.resets or _split_by_a_region(regions, {place, *consumer.post}):
             continue
         if tid in producers[place]:
             continue
@@ -121,8 +125,14 @@ def reduce_net(net: Net) -> ReducedNet:
                 tuple(sorted(t.pre.items())),
                 tuple(sorted(t.post.items())),
                 tuple(t.firings),
-                t.resets,
+                # A removed place is never marked in the reduced net: nothing to empty there.
+                tuple(place for place in t.resets if place not in removed),
             )
             for t in transitions.values()
         ),
     )
+
+
+def _split_by_a_region(regions: set[frozenset[str]], places: set[str]) -> bool:
+    """Whether some reset region empties part of `places` but not all of them."""
+    return any(not region.isdisjoint(places) and not places <= region for region in regions)
