@@ -62,11 +62,23 @@ def test_every_witness_replays_from_the_initial_marking(data: dict[str, Any]) ->
 
 
 def _emptied(data: dict[str, Any]) -> dict[str, set[str]]:
-    """What each transition's `cancels` empties, read from the document itself."""
+    """What each transition's `cancels` empties, read from the document as pattern-format.md says:
+    the places, and for a task its running place and the func constraint places of its run."""
     process = data["processes"][0]
-    tasks = {t["id"] for t in process["transitions"] if "performer" in t}
+    performer = {t["id"]: t.get("performer") for t in process["transitions"]}
+    kinds = {a["id"]: a["type"] for a in data["actors"]}
+    run: dict[str, set[str]] = {t: {f"running:{t}"} for t, p in performer.items() if p}
+    for c in data["constraints"]:
+        if c["type"] == "func":
+            a, b = c["from"], c["to"]
+            s, d = (
+                (b, a)
+                if [kinds[performer[a]], kinds[performer[b]]] == ["operator", "cobot"]
+                else (a, b)
+            )
+            run[s] |= {f"func-start:{s}>{d}", f"func-done:{d}>{s}"}
     return {
-        t["id"]: {f"running:{node}" if node in tasks else node for node in t.get("cancels", ())}
+        t["id"]: {place for node in t.get("cancels", ()) for place in run.get(node, {node})}
         for t in process["transitions"]
     }
 
