@@ -7,6 +7,10 @@ expanded back into the original firings, is the witness shown to the
 engineer (shortest up to the steps the reduction takes at once: a chain of
 firings that nothing can interrupt is shown whole).
 
+Reset arcs (`cancels`) are honoured, and they weaken one argument: a marking
+that covers an ancestor proves a place unbounded only if no firing on the way
+between them empties that place, since repeating the way would empty it again.
+
 Exploration stops at the budget's `max_markings` or its deadline (see
 `budget`), and so do the phases after it that walk every marking; whatever
 was found by then is reported, and a verdict that needs the whole space
@@ -88,6 +92,7 @@ class _Explorer:
         self.index = {place: i for i, place in enumerate(reduced.places)}
         self.pre = [self._tokens(t.pre) for t in reduced.transitions]
         self.post = [self._tokens(t.post) for t in reduced.transitions]
+        self.resets = [frozenset(self.index[p] for p in t.resets) for t in reduced.transitions]
         self.need = [Counter(pre) for pre in self.pre]
         # Candidates per marked place, so a marking only tests transitions it can feed.
         self.consumers: list[list[int]] = [[] for _ in reduced.places]
@@ -126,6 +131,8 @@ class _Explorer:
                 tokens = list(state)
                 for i in self.pre[t]:
                     tokens.remove(i)
+                if self.resets[t]:
+                    tokens = [i for i in tokens if i not in self.resets[t]]
                 tokens.extend(self.post[t])
                 tokens.sort()
                 yield t, tuple(tokens)
@@ -180,24 +187,28 @@ class _Explorer:
         return True
 
     def _covering(self, number: int) -> Fault | None:
-        """An ancestor this marking strictly covers proves a place unbounded (Karp–Miller)."""
+        """An ancestor this marking strictly covers proves a place unbounded (Karp–Miller),
+        when a place that grew is emptied by no reset on the way from the ancestor."""
         state = self.order[number]
         counts = Counter(state)
+        emptied: set[int] = set()
         link = self.parent[number]
         while link is not None:
-            ancestor, _ = link
+            ancestor, t = link
+            emptied |= self.resets[t]
             # Fewer tokens first: it is cheap and rules out most ancestors of a bounded net.
             fewer = len(self.order[ancestor]) < len(state)
             if fewer and (smaller := Counter(self.order[ancestor])) <= counts:
-                grown = next(i for i in counts if counts[i] > smaller[i])
-                prefix = self.path(ancestor)
-                return Fault(
-                    "unbounded",
-                    self.marking(state),
-                    witness=prefix,
-                    place=self.reduced.places[grown],
-                    repeat=self.path(number)[len(prefix) :],
-                )
+                grown = [i for i in counts if counts[i] > smaller[i] and i not in emptied]
+                if grown:
+                    prefix = self.path(ancestor)
+                    return Fault(
+                        "unbounded",
+                        self.marking(state),
+                        witness=prefix,
+                        place=self.reduced.places[grown[0]],
+                        repeat=self.path(number)[len(prefix) :],
+                    )
             link = self.parent[ancestor]
         return None
 

@@ -13,6 +13,11 @@ extra places (pattern-format.md, "Execution semantics"):
 - space (a, b): no place; the order is free and the runtime interrupts the
   cobot while both run.
 
+A silent transition with `cancels` resets what it names when it fires: a
+place is emptied, a task's `running:t` too (the task is cancelled), and with
+it the func constraint places that stand for that run of t: `func-start:t>d`
+(t runs, so d may start) and `func-done:d>t` (d completed, for t to complete).
+
 Call it only on a pattern whose rules hold (`rules.check_rules` found nothing
 structural): it assumes every arc, performer and constraint end exists.
 """
@@ -22,8 +27,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
-from hrc.engine.model import Constraint, Pattern
+from hrc.engine.model import Constraint, Pattern, Process, Transition
 from hrc.engine.petri import Marking, Net, NetTransition
+from hrc.engine.taskconfig import ConfigError, cancels_of
 
 Arcs = dict[str, list[tuple[str, int]]]
 
@@ -94,6 +100,7 @@ def build_execution_net(pattern: Pattern) -> Net:
     post: Arcs = defaultdict(list)
     places: list[str] = []
     transitions: list[tuple[str, str, str]] = []  # (id, task, kind)
+    resets: dict[str, tuple[str, ...]] = {}
     initial: dict[str, int] = {}
     final: dict[str, int] = {}
     for process in pattern.processes:
@@ -114,6 +121,7 @@ def build_execution_net(pattern: Pattern) -> Net:
             if not transition.is_task:
                 transitions.append((t, t, "silent"))
                 pre[t], post[t] = inputs[t], outputs[t]
+                resets[t] = _resets(process, transition)
                 continue
             running = f"running:{t}"
             places.append(running)
@@ -123,19 +131,50 @@ def build_execution_net(pattern: Pattern) -> Net:
             pre[f"complete:{t}"] = [(running, 1)]
             post[f"complete:{t}"] = list(outputs[t])
     ignored = constraint_places(pattern)
+    run_of: dict[str, list[str]] = defaultdict(list)  # task -> func places of its current run
     for place, constraint in ignored.items():
         places.append(place)
         post[constraint.producer].append((place, 1))
         pre[constraint.consumer].append((place, 1))
+        if constraint.kind != "time":
+            supporter = constraint.first if constraint.kind == "func-start" else constraint.second
+            run_of[f"running:{supporter}"].append(place)
+    for t, emptied in resets.items():
+        resets[t] = tuple(p for place in emptied for p in (place, *run_of.get(place, ())))
     return Net(
         places=tuple(dict.fromkeys(places)),
         transitions=tuple(
-            NetTransition(tid, task, kind, tuple(_merged(pre[tid])), tuple(_merged(post[tid])))  # type: ignore[arg-type]
+            NetTransition(
+                tid,
+                task,
+                kind,  # type: ignore[arg-type]
+                tuple(_merged(pre[tid])),
+                tuple(_merged(post[tid])),
+                resets.get(tid, ()),
+            )
             for tid, task, kind in transitions
         ),
         initial=Marking(initial),
         final=Marking(final),
         ignored=frozenset(ignored),
+    )
+
+
+def _resets(process: Process, transition: Transition) -> tuple[str, ...]:
+    """The places a silent transition's `cancels` empties: places as named, a task's `running:`.
+
+    A malformed `cancels` is a task-config error of the check, which still
+    decides soundness; the net then has no reset there, as without the key."""
+    try:
+        cancelled = cancels_of(process, transition)
+    except ConfigError:
+        return ()
+    places = {p.id for p in process.places}
+    tasks = {t.id for t in process.transitions if t.is_task}
+    return tuple(
+        node if node in places else f"running:{node}"
+        for node in cancelled
+        if node in places or node in tasks
     )
 
 

@@ -26,7 +26,16 @@ STRUCTURAL_CODES = (
     "not-workflow-net",
 )
 # task-config: a task, guard or message configuration the runtime could not run (taskconfig.py).
-ERROR_CODES = (*STRUCTURAL_CODES, "task-config", "pattern-mismatch", "unsound", "unbounded")
+# to-rewrite: a transition or place carries a `rewrite` note, a piece an importer could not
+# translate; the model stays a draft until someone rewrites it.
+ERROR_CODES = (
+    *STRUCTURAL_CODES,
+    "task-config",
+    "to-rewrite",
+    "pattern-mismatch",
+    "unsound",
+    "unbounded",
+)
 # state-space-too-large: soundness was not decided within the check's budget (budget.py), its
 # markings or its seconds; the message says which ("too large to decide in 2 s").
 WARNING_CODES = ("vacuous-pattern", "no-pattern", "state-space-too-large")

@@ -5,6 +5,10 @@ execution net that `execution.build_execution_net` compiles from a pattern
 (every task split into start and complete, constraints as extra places).
 Markings are immutable mappings from place to a positive token count; places
 with no token are absent, so two equal markings compare equal.
+
+A transition may also reset places (YAWL's cancellation region): firing it
+empties them, whatever they hold, without needing a token there. This is how
+a terminate end or an interrupting event cancels work still under way.
 """
 
 from collections.abc import Iterable, Iterator, Mapping
@@ -64,7 +68,8 @@ class NetTransition:
 
     `id` is unique in the net: `start:<task>`, `complete:<task>`, or the id of
     a silent transition of the pattern. `task` is the pattern transition it
-    belongs to.
+    belongs to. `resets` are the places firing empties after taking `pre` and
+    before putting `post` (reset arcs); they play no part in enabling.
     """
 
     id: str
@@ -72,6 +77,7 @@ class NetTransition:
     kind: FiringKind
     pre: tuple[tuple[str, int], ...]
     post: tuple[tuple[str, int], ...]
+    resets: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
@@ -86,6 +92,8 @@ class NetTransition:
         tokens = dict(marking)
         for place, weight in self.pre:
             tokens[place] -= weight
+        for place in self.resets:
+            tokens.pop(place, None)
         for place, weight in self.post:
             tokens[place] = tokens.get(place, 0) + weight
         return Marking(tokens)

@@ -18,6 +18,14 @@ from every marking, proper completion, boundedness, and which transitions
 can fire. Every reduced transition remembers the original firings it stands
 for, so a witness found in the reduced net expands into a firing sequence of
 the original.
+
+Reset arcs (`cancels`) are kept: a producer h keeps its resets, which happen
+before t's tokens arrive as they would have. A reset region must take p and
+t's outputs together or leave them all alone: then emptying the region
+gives the same marking whether t fired already or not (a terminate that
+empties its whole process keeps the process' chains reducible), while a
+region with p in it and t's outputs outside would have t move tokens out of
+its reach.
 """
 
 from collections import defaultdict
@@ -31,6 +39,7 @@ class _Transition:
     pre: dict[str, int]
     post: dict[str, int]
     firings: list[str]
+    resets: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -39,6 +48,8 @@ class ReducedTransition:
     post: tuple[tuple[str, int], ...]
     firings: tuple[str, ...]
     """The original transitions' ids, in an order in which they can fire."""
+    resets: tuple[str, ...] = ()
+    """The places it empties after taking `pre`, before putting `post`."""
 
 
 @dataclass(frozen=True)
@@ -58,9 +69,15 @@ def reduce_net(net: Net) -> ReducedNet:
     something (so tokens piling up in p still show as unboundedness).
     Under these, any firing sequence of the original can be reordered to fire
     t right after the h that marked p: firing t earlier only adds tokens
-    sooner and takes none that another transition needed.
+    sooner and takes none that another transition needed. With reset arcs,
+    also: t resets nothing, and each transition's resets hold either p and
+    every place t produces into, or none of them; so firing t earlier either
+    commutes with a reset or is undone by it exactly.
     """
-    transitions = {t.id: _Transition(dict(t.pre), dict(t.post), [t.id]) for t in net.transitions}
+    transitions = {
+        t.id: _Transition(dict(t.pre), dict(t.post), [t.id], t.resets) for t in net.transitions
+    }
+    regions = {frozenset(t.resets) for t in net.transitions if t.resets}
     producers: dict[str, set[str]] = defaultdict(set)
     consumers: dict[str, set[str]] = defaultdict(set)
     for tid, transition in transitions.items():
@@ -81,6 +98,8 @@ def reduce_net(net: Net) -> ReducedNet:
         (tid,) = consumers[place]
         consumer = transitions[tid]
         if consumer.pre != {place: 1} or place in consumer.post or not consumer.post:
+            continue
+        if consumer.resets or _split_by_a_region(regions, {place, *consumer.post}):
             continue
         if tid in producers[place]:
             continue
@@ -103,8 +122,17 @@ def reduce_net(net: Net) -> ReducedNet:
         places=kept,
         transitions=tuple(
             ReducedTransition(
-                tuple(sorted(t.pre.items())), tuple(sorted(t.post.items())), tuple(t.firings)
+                tuple(sorted(t.pre.items())),
+                tuple(sorted(t.post.items())),
+                tuple(t.firings),
+                # A removed place is never marked in the reduced net: nothing to empty there.
+                tuple(place for place in t.resets if place not in removed),
             )
             for t in transitions.values()
         ),
     )
+
+
+def _split_by_a_region(regions: set[frozenset[str]], places: set[str]) -> bool:
+    """Whether some reset region empties part of `places` but not all of them."""
+    return any(not region.isdisjoint(places) and not places <= region for region in regions)

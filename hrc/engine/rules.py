@@ -2,7 +2,8 @@
 
 `check_rules` assumes the document's shape is right (document.read_pattern
 succeeded) and reports every broken rule it finds, so an engineer sees all
-of them at once instead of one per save.
+of them at once instead of one per save. Besides the 7-tuple's rules it
+reports each `rewrite` note (`to-rewrite`), which leaves the net well formed.
 """
 
 from collections import Counter, defaultdict
@@ -17,7 +18,8 @@ __all__ = ["STRUCTURAL_CODES", "check_rules"]
 
 
 def check_rules(pattern: Pattern) -> list[Issue]:
-    """Every broken structural rule of the 7-tuple, in the order of pattern-format.md."""
+    """Every broken structural rule of the 7-tuple, in the order of pattern-format.md, then
+    every element still to rewrite."""
     names = Names(pattern)
     return [
         *_duplicate_ids(pattern, names),
@@ -28,6 +30,7 @@ def check_rules(pattern: Pattern) -> list[Issue]:
         *_no_actors(pattern, names),
         *_workpieces(pattern, names),
         *(issue for process in pattern.processes for issue in _workflow_net(process, names)),
+        *_to_rewrite(pattern, names),
     ]
 
 
@@ -296,3 +299,23 @@ def _workflow_net(process: Process, names: Names) -> Iterable[Issue]:
             process.id,
             *stray,
         )
+
+
+def _to_rewrite(pattern: Pattern, names: Names) -> Iterable[Issue]:
+    """A `rewrite` note marks what an importer could not say in hrc's terms (a condition in
+    another expression language, a loop without a condition): the model cannot run as meant."""
+    for process in pattern.processes:
+        notes = [(p.id, p.extra) for p in process.places]
+        notes += [(t.id, t.extra) for t in process.transitions]
+        for node, extra in notes:
+            if "rewrite" not in extra:
+                continue
+            note = extra["rewrite"]
+            what = note.strip().rstrip(".") if isinstance(note, str) else ""
+            yield error(
+                "to-rewrite",
+                f"{sentence(names.node(node))} needs rewriting"
+                + (f": {what}. " if what else ". ")
+                + "Rewrite it in hrc's terms, then remove its 'rewrite' key.",
+                node,
+            )

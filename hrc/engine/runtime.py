@@ -8,7 +8,10 @@ case data) and returns the next marking, so the database row stays the one
 truth and the same rule serves the runtime, the token game and the tests.
 
 - Silent transitions fire at once (`settle`), in net order, when their guard
-  holds; a message transition waits for its message instead.
+  holds; a message transition waits for its message instead, and a timer
+  transition for its time (the caller keeps the clock and `ring`s it).
+- A transition with `cancels` empties what it names when it fires; a task
+  whose `running:` place it empties is cancelled (the caller compares).
 - A task whose start is enabled is offered; starting one consumes its input
   tokens, so the other tasks of a deferred choice are no longer startable.
 - time and func constraints are places of the execution net, so `start` and
@@ -35,6 +38,7 @@ from hrc.engine.taskconfig import (
     send_of,
     space_modes,
     task_config,
+    timer_of,
 )
 
 # A guard-driven loop of silent transitions that never stops is a modelling
@@ -129,6 +133,7 @@ class CaseNet:
         self.guards: dict[str, str] = {}
         self.messages: dict[str, MessageConfig] = {}
         self.sends: dict[str, SendConfig] = {}
+        self.timers: dict[str, int] = {}
         for _, transition in pattern.transitions():
             self.labels[transition.id] = transition.label or transition.id
             send = send_of(transition)
@@ -144,6 +149,16 @@ class CaseNet:
             message = message_of(transition)
             if message is not None:
                 self.messages[transition.id] = message
+            timer = timer_of(transition)
+            if timer is not None:
+                self.timers[transition.id] = timer
+        # The silent transitions settle fires: those waiting for neither a message nor a timer.
+        self._eager = tuple(
+            t
+            for t in self.net.transitions
+            if t.kind == "silent" and t.id not in self.messages and t.id not in self.timers
+        )
+        self._timed = tuple(t for t in self.net.transitions if t.id in self.timers)
         self.space_pairs = self._space_pairs()
         self.space_tasks = frozenset(
             task for pair in self.space_pairs for task in (pair.first, pair.second)
@@ -197,7 +212,8 @@ class CaseNet:
     # Silent transitions ------------------------------------------------------------
 
     def settle(self, marking: Marking, data: Mapping[str, Any]) -> tuple[Marking, list[str]]:
-        """Fires enabled silent transitions (guard holding, no message awaited) until none is left.
+        """Fires enabled silent transitions (guard holding, no message or timer awaited) until none
+        is left.
 
         Returns the marking and the transitions fired, in order. Raises
         RuntimeFault when a guard cannot be evaluated or silent firings do not stop.
@@ -216,9 +232,7 @@ class CaseNet:
             fired.append(transition.id)
 
     def _next_silent(self, marking: Marking, data: Mapping[str, Any]) -> NetTransition | None:
-        for transition in self.net.transitions:
-            if transition.kind != "silent" or transition.id in self.messages:
-                continue
+        for transition in self._eager:
             if transition.is_enabled(marking) and self._guard_holds(transition.id, data):
                 return transition
         return None
@@ -246,6 +260,19 @@ class CaseNet:
             # Otherwise any silent transition (guard unchecked) or task start would fire here.
             raise NotEnabled(f"{transition} waits for no message.")
         return self._fire(marking, transition, f"the message of {transition}")
+
+    def waiting_timers(self, marking: Marking) -> list[tuple[str, int]]:
+        """The timer transitions enabled in `marking` and their durations in ms, in net order:
+        what rings once it has stayed enabled that long."""
+        return [(t.id, self.timers[t.id]) for t in self._timed if t.is_enabled(marking)]
+
+    def ring(self, marking: Marking, transition: str) -> Marking:
+        """Fires a timer transition whose time is up; raises NotEnabled when it is not an enabled
+        timer transition. The caller settles after it, as after `receive`."""
+        if transition not in self.timers:
+            # Otherwise any silent transition (guard unchecked) or task start would fire here.
+            raise NotEnabled(f"{transition} has no timer.")
+        return self._fire(marking, transition, f"the timer of {transition}")
 
     # Tasks -------------------------------------------------------------------------
 

@@ -25,6 +25,11 @@ A transition of an `hrc-pattern/1` document may carry, beside the formal model:
   it fires): `{"name": "...", "correlation": {"key": value}, "payload": {"key": value}}`;
   a message that correlates like one from outside, to another case or to
   another process of the same case.
+- `"timer"` on a silent transition: an ISO 8601 duration (`"PT5M"`); it fires
+  once it has been enabled that long without interruption, never by itself
+  before; not together with a guard or a message.
+- `"cancels"` on a silent transition: the ids of places and tasks of its own
+  process that it empties when it fires (a running task is cancelled).
 
 Message correlation and send expressions read `case` (its `id` and
 `reference`) besides `data`: `=case.id` keeps a message inside its case.
@@ -41,13 +46,15 @@ Configuration values are literals or expressions (a string starting with "=",
 see expressions.py), resolved against the case data when the task starts.
 """
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from decimal import Decimal
 from typing import Any, Final, Literal
 
 from hrc.engine import expressions
 from hrc.engine.issues import Issue, error
-from hrc.engine.model import Actor, Pattern, Transition
+from hrc.engine.model import Actor, Pattern, Process, Transition
 from hrc.engine.wording import Names, sentence
 
 TaskKind = Literal["operator", "step", "device"]
@@ -395,6 +402,84 @@ def send_of(transition: Transition) -> SendConfig | None:
     return SendConfig(raw["name"], parts["correlation"], parts["payload"])
 
 
+# PnW, or PnDTnHnMnS with any part left out; a part may have a fraction (PT0.5S, P1,5D).
+_NUMBER = r"(\d+(?:[.,]\d+)?)"
+_DURATION = re.compile(
+    rf"P(?:{_NUMBER}W|(?:{_NUMBER}D)?(?:T(?=\d)(?:{_NUMBER}H)?(?:{_NUMBER}M)?(?:{_NUMBER}S)?)?)"
+)
+_YEARS_OR_MONTHS = re.compile(r"P[^T]*[YM].*")
+_MILLISECONDS = (7 * 86_400_000, 86_400_000, 3_600_000, 60_000, 1000)  # W, D, H, M, S
+MAX_TIMER_MS: Final = 366 * 86_400_000
+
+
+def parse_duration(text: str) -> int:
+    """An ISO 8601 duration (`PT5M`, `P1DT2H`, `PT0.5S`, `P2W`) in milliseconds.
+
+    Raises ValueError with a message a person can act on: years and months are
+    refused, having no fixed length, and so is anything longer than a year."""
+    written = text.strip().upper()
+    match = _DURATION.fullmatch(written)
+    if match is None or not any(match.groups()):
+        if _YEARS_OR_MONTHS.fullmatch(written):
+            raise ValueError(
+                f"{text!r} counts years or months, which have no fixed length; "
+                "write the duration in weeks, days, hours, minutes and seconds (P30D)."
+            )
+        raise ValueError(
+            f"{text!r} is not an ISO 8601 duration such as PT5M (5 minutes), PT30S or P1DT2H."
+        )
+    total = sum(
+        (
+            Decimal(part.replace(",", ".")) * unit
+            for part, unit in zip(match.groups(), _MILLISECONDS, strict=True)
+            if part is not None
+        ),
+        Decimal(0),
+    )
+    if total > MAX_TIMER_MS:
+        raise ValueError(f"{text!r} is longer than a year; a timer waits at most P366D.")
+    return int(total.to_integral_value())
+
+
+def timer_of(transition: Transition) -> int | None:
+    """How long a silent transition waits once enabled, in milliseconds; None without a timer."""
+    raw = transition.extra.get("timer")
+    if raw is None:
+        return None
+    if not isinstance(raw, str):
+        raise ConfigError(transition.id, "'timer' must be an ISO 8601 duration such as \"PT5M\".")
+    try:
+        return parse_duration(raw)
+    except ValueError as problem:
+        raise ConfigError(transition.id, f"'timer': {problem}") from None
+
+
+def cancels_of(process: Process, transition: Transition) -> tuple[str, ...]:
+    """The places and tasks of `process` that a silent transition empties when it fires,
+    as written; () without `cancels`.
+
+    Raises ConfigError for a value that is no list of ids, or an id that is no
+    place or transition of the process. A silent transition may be named too
+    (an importer may list a whole region); it holds nothing, so that changes nothing.
+    """
+    raw = transition.extra.get("cancels")
+    if raw is None:
+        return ()
+    t = transition.id
+    if not isinstance(raw, list) or not all(isinstance(node, str) for node in raw):
+        raise ConfigError(t, "'cancels' must be a list of place and task ids.")
+    nodes = {p.id for p in process.places} | {n.id for n in process.transitions}
+    foreign = [node for node in raw if node not in nodes]
+    if foreign:
+        raise ConfigError(
+            t,
+            f"'cancels' names {', '.join(repr(n) for n in foreign)}, which "
+            f"{'is' if len(foreign) == 1 else 'are'} no place or task of its process "
+            f"{process.id}: a transition cancels work of its own process only.",
+        )
+    return tuple(dict.fromkeys(raw))
+
+
 def _check_nested(t: str, what: str, value: object) -> None:
     """A send value's expressions, also inside lists and objects, as resolve() will find them."""
     if isinstance(value, list):
@@ -437,32 +522,48 @@ def _device_end(pattern: Pattern, tasks: list[str]) -> str | None:
     return None
 
 
+# The keys only a silent transition may carry.
+SILENT_KEYS: Final = ("guard", "message", "timer", "cancels")
+
+
+def _check_silent(process: Process, transition: Transition) -> None:
+    if "task" in transition.extra:
+        raise ConfigError(transition.id, "a silent transition runs no 'task'.")
+    send_of(transition)
+    cancels_of(process, transition)
+    guard, message = guard_of(transition), message_of(transition)
+    if guard is not None and message is not None:
+        raise ConfigError(
+            transition.id,
+            "a transition waits for a message or has a guard, not both: "
+            "put the guard on a silent transition after it.",
+        )
+    if timer_of(transition) is not None and (guard is not None or message is not None):
+        raise ConfigError(
+            transition.id,
+            f"a transition waits for a timer or {'a message' if message else 'has a guard'}, "
+            "not both: put the other on a silent transition of its own.",
+        )
+
+
 def config_issues(pattern: Pattern) -> list[Issue]:
-    """Every malformed task, guard or message configuration, as `task-config` errors."""
+    """Every malformed task, guard, message, timer or cancels configuration, as `task-config` errors."""
     issues = []
     names = Names(pattern)
     try:
         initial_data(pattern)
     except ConfigError as problem:
         issues.append(error("task-config", str(problem)))
-    for _, transition in pattern.transitions():
+    for process, transition in pattern.transitions():
         try:
             if transition.is_task:
-                for key in ("guard", "message"):
+                for key in SILENT_KEYS:
                     if key in transition.extra:
                         raise ConfigError(transition.id, f"only silent transitions have a '{key}'.")
                 task_config(pattern, transition)
                 send_of(transition)
             else:
-                if "task" in transition.extra:
-                    raise ConfigError(transition.id, "a silent transition runs no 'task'.")
-                send_of(transition)
-                if guard_of(transition) is not None and message_of(transition) is not None:
-                    raise ConfigError(
-                        transition.id,
-                        "a transition waits for a message or has a guard, not both: "
-                        "put the guard on a silent transition after it.",
-                    )
+                _check_silent(process, transition)
         except ConfigError as problem:
             where = sentence(names.node(transition.id))
             issues.append(error("task-config", f"{where}: {problem.problem}", transition.id))

@@ -16,7 +16,8 @@ on the pattern's own elements:
       "transitions": [
         {"id": "start:tc1", "label": "start tc1", "kind": "start", "task": "tc1", "performer": "c"},
         {"id": "complete:tc1", "label": "complete tc1", "kind": "complete", "task": "tc1", "performer": "c"},
-        {"id": "t1", "label": "t1", "kind": "silent", "task": "t1", "performer": null}
+        {"id": "t1", "label": "t1", "kind": "silent", "task": "t1", "performer": null,
+         "resets": ["p4", "running:tc1"]}
       ],
       "arcs": [["p2", "start:tc1"], ["start:tc1", "running:tc1"], ...],
       "initial": {"p1": 1},
@@ -34,7 +35,9 @@ on the pattern's own elements:
 - a transition is a task's `start` or `complete`, or a `silent` step of the
   pattern (`task`: the pattern transition it belongs to);
 - a transition fires when each of its input places holds a token, taking one
-  from each and putting one in each output place; silent steps fire at once;
+  from each, emptying its `resets` places (a `cancels` key: `running:t`
+  cancels task t), and putting one in each output place; silent steps fire
+  at once, the game leaving a timer's wait out;
 - the case ends properly in `final`, whatever the `ignored` (constraint)
   places hold.
 """
@@ -77,6 +80,7 @@ def execution_net_json(pattern: Pattern) -> Json:
             "kind": t.kind,
             "task": t.task,
             "performer": performers.get(t.task),
+            "resets": list(t.resets),
         }
         for t in net.transitions
     ]

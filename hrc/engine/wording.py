@@ -16,6 +16,8 @@ class Names:
         self.labels: dict[str, str] = {}
         self.tasks: set[str] = set()
         self.places: set[str] = set()
+        self.timers: set[str] = set()
+        self.cancels: dict[str, list[str]] = {}
         for process in pattern.processes:
             for place in process.places:
                 self.places.add(place.id)
@@ -26,6 +28,13 @@ class Names:
                 self.tasks.add(transition.id)
                 if transition.label and transition.label.strip():
                     self.labels[transition.id] = transition.label.strip()
+                if transition.is_task:
+                    continue
+                if "timer" in transition.extra:
+                    self.timers.add(transition.id)
+                cancels = transition.extra.get("cancels")
+                if isinstance(cancels, list) and cancels:
+                    self.cancels[transition.id] = [c for c in cancels if isinstance(c, str)]
 
     def name(self, element_id: str) -> str:
         """“pick insert” for a labelled task or place, its id otherwise."""
@@ -54,7 +63,8 @@ class Names:
         if element_id in self.tasks:
             transition = self.pattern.transition(element_id)
             if transition is not None and not transition.is_task:
-                return f"split/join {self.name(element_id)}"
+                kind = "timer" if element_id in self.timers else "split/join"
+                return f"{kind} {self.name(element_id)}"
             return self.task(element_id)
         if element_id in self.places:
             return self.place(element_id)
@@ -67,12 +77,16 @@ class Names:
         return f"{', '.join(named[:limit])} and {len(named) - limit} more"
 
     def firing(self, kind: str, task_id: str) -> str:
-        """A step of a firing sequence: `“pick insert” starts`, `“pick insert” completes`."""
+        """A step of a firing sequence: `“pick insert” starts`, `“pick insert” completes`,
+        `split/join t1 fires`, `timer t2 rings and cancels task tc1`."""
         if kind == "start":
             return f"{self.task(task_id)} starts"
         if kind == "complete":
             return f"{self.task(task_id)} completes"
-        return f"{self.node(task_id)} fires"
+        step = f"{self.node(task_id)} {'rings' if task_id in self.timers else 'fires'}"
+        if task_id in self.cancels:
+            step += f" and cancels {self.nodes(self.cancels[task_id], limit=3)}"
+        return step
 
 
 def sentence(text: str) -> str:

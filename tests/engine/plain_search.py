@@ -3,18 +3,19 @@
 Deliberately naive and independent of `hrc.engine.analysis`: no reduction,
 the whole execution net, the textbook definition of soundness (van der
 Aalst) with constraint places set aside for proper completion, and the
-Karp–Miller ancestor cover test for unboundedness.
+Karp–Miller ancestor cover test for unboundedness: with reset arcs, a place
+that grew proves it only when no firing on the way from the ancestor resets it.
 """
 
 from collections import deque
 
-from hrc.engine.petri import Marking, Net
+from hrc.engine.petri import Marking, Net, NetTransition
 
 
 def plain_soundness(net: Net, limit: int = 100_000) -> bool:
     """True when sound and bounded; raises RuntimeError past `limit` markings."""
     start = net.initial
-    parents: dict[Marking, Marking | None] = {start: None}
+    parents: dict[Marking, tuple[Marking, NetTransition] | None] = {start: None}
     successors: dict[Marking, list[Marking]] = {}
     fired: set[str] = set()
     queue = deque([start])
@@ -29,7 +30,7 @@ def plain_soundness(net: Net, limit: int = 100_000) -> bool:
             successors[marking].append(after)
             if after in parents:
                 continue
-            parents[after] = marking
+            parents[after] = (marking, transition)
             if _covers_an_ancestor(after, parents):
                 return False
             if len(parents) > limit:
@@ -50,12 +51,18 @@ def plain_soundness(net: Net, limit: int = 100_000) -> bool:
     return len(can_finish) == len(parents)
 
 
-def _covers_an_ancestor(marking: Marking, parents: dict[Marking, Marking | None]) -> bool:
-    ancestor = parents[marking]
-    while ancestor is not None:
-        if ancestor != marking and all(marking.get(p) >= n for p, n in ancestor.items()):
+def _covers_an_ancestor(
+    marking: Marking, parents: dict[Marking, tuple[Marking, NetTransition] | None]
+) -> bool:
+    emptied: set[str] = set()
+    link = parents[marking]
+    while link is not None:
+        ancestor, transition = link
+        emptied.update(transition.resets)
+        covers = all(marking.get(p) >= n for p, n in ancestor.items())
+        if covers and any(marking[p] > ancestor.get(p) and p not in emptied for p in marking):
             return True
-        ancestor = parents[ancestor]
+        link = parents[ancestor]
     return False
 
 

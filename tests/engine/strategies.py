@@ -159,3 +159,22 @@ def decorated(draw: st.DrawFn) -> dict[str, Any]:
     if draw(st.booleans()):
         process["places"][0]["tokens"] = draw(st.integers(0, 3))
     return data
+
+
+@st.composite
+def cancelling(draw: st.DrawFn) -> dict[str, Any]:
+    """A generated pattern whose silent transitions may cancel some of its places and tasks, and
+    maybe one more like a terminate end: from a place straight to the end, cancelling everything."""
+    data = draw(patterns())
+    process = data["processes"][0]
+    places = [p["id"] for p in process["places"]]
+    nodes = places + [t["id"] for t in process["transitions"]]
+    if draw(st.booleans()):
+        # places[1] is the end place; every other one lies on a way to it.
+        place = draw(st.sampled_from([p for p in places if p != places[1]]))
+        process["transitions"].append({"id": "tx", "cancels": list(nodes)})
+        process["arcs"] += [[place, "tx"], ["tx", places[1]]]
+    for transition in process["transitions"]:
+        if "performer" not in transition and "cancels" not in transition and draw(st.booleans()):
+            transition["cancels"] = draw(st.lists(st.sampled_from(nodes), max_size=4))
+    return data

@@ -112,6 +112,11 @@ def _bad_task_config(data: Doc) -> None:
     task["task"] = {"step": {"number": "=data.step +"}}
 
 
+def _to_rewrite(data: Doc) -> None:
+    split = next(t for t in _net(data)["transitions"] if t["id"] == "t1")
+    split["rewrite"] = "the condition ${count > 3 && ok} is in JUEL"
+
+
 def _deadlock(data: Doc) -> None:
     data["constraints"].append({"from": "tc3", "to": "to1", "type": "time"})
 
@@ -158,6 +163,7 @@ CASES: list[tuple[str, Callable[[Doc], None], str, set[str]]] = [
     ("node on no path from source to sink", _stray_cycle, "not-workflow-net", {"p10", "t3"}),
     ("declared pattern does not hold", _declared_wrongly, "pattern-mismatch", set()),
     ("a task configuration that cannot run", _bad_task_config, "task-config", {"tc1"}),
+    ("an imported piece still to rewrite", _to_rewrite, "to-rewrite", {"t1"}),
     ("time constraints against each other", _deadlock, "unsound", {"tc2", "to1"}),
     ("a loop that adds a token each round", _unbounded, "unbounded", set()),
 ]
@@ -260,6 +266,31 @@ def test_the_unmutated_model_breaks_no_rule() -> None:
 def test_every_error_code_has_a_case_here_or_in_the_format_tests() -> None:
     covered = {case[2] for case in CASES} | {"format"}  # format: tests/engine/test_document.py
     assert set(ERROR_CODES) == covered
+
+
+def test_each_rewrite_note_is_an_error_that_quotes_it_and_leaves_soundness_decided() -> None:
+    data = _mutated(_to_rewrite)
+    _net(data)["places"][3]["label"] = "tray full"
+    _net(data)["places"][3]["rewrite"] = True
+
+    report = check_document(data)
+
+    assert [(i.code, i.elements, i.message) for i in report.errors] == [
+        (
+            "to-rewrite",
+            ("p4",),
+            "Place “tray full” needs rewriting. Rewrite it in hrc's terms, then remove its "
+            "'rewrite' key.",
+        ),
+        (
+            "to-rewrite",
+            ("t1",),
+            "Split/join t1 needs rewriting: the condition ${count > 3 && ok} is in JUEL. "
+            "Rewrite it in hrc's terms, then remove its 'rewrite' key.",
+        ),
+    ]
+    assert report.valid is False
+    assert report.sound is True
 
 
 def test_a_broken_rule_leaves_soundness_undecided() -> None:

@@ -21,6 +21,7 @@ def test_tasks_split_into_start_and_complete_around_a_busy_place() -> None:
         "kind": "start",
         "task": "tc1",
         "performer": "c",
+        "resets": [],
     }
     assert transitions["t1"]["kind"] == "silent"
     assert transitions["t1"]["performer"] is None
