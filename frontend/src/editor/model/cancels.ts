@@ -2,28 +2,23 @@
  * A silent transition's `cancels` key: the places and tasks of its own process
  * it empties when it fires (BPMN's terminate end events and interrupting
  * boundary events). The engine's check has the final word; the panel refuses
- * early what it would refuse: unknown ids, silent transitions (they never
- * run), and elements of another process.
+ * early what it would refuse: ids of no node, and nodes of another process.
+ * A silent transition may be listed (an importer may list a whole region): it
+ * holds nothing, so that cancels nothing.
  */
-
-/** What the panel knows of a node it may be asked to cancel. */
-export interface CancelTarget {
-  kind: "place" | "task" | "silent";
-  process: string;
-}
 
 /**
  * The ids of a comma- or space-separated list, each once and in the order written.
- * `process` is the cancelling transition's; `lookup` finds any node of the document.
+ * `process` is the cancelling transition's; `processOf` gives the process of any
+ * node of the document, undefined for an id that is no node.
  * Throws an Error naming every id that cannot be cancelled.
  */
-export function parseCancels(text: string, process: string, lookup: (id: string) => CancelTarget | undefined): string[] {
+export function parseCancels(text: string, process: string, processOf: (id: string) => string | undefined): string[] {
   const ids = [...new Set(text.split(/[\s,;]+/).filter(Boolean))];
   const problems = ids.flatMap((id) => {
-    const target = lookup(id);
-    if (!target) return [`${id} is no place or task of this pattern`];
-    if (target.kind === "silent") return [`${id} is a silent transition, which never runs`];
-    if (target.process !== process) return [`${id} is in net ${target.process}, not in this transition's net ${process}`];
+    const found = processOf(id);
+    if (found === undefined) return [`${id} is no place or task of this pattern`];
+    if (found !== process) return [`${id} is in net ${found}, not in this transition's net ${process}`];
     return [];
   });
   if (problems.length) throw new Error(`Cannot cancel: ${problems.join("; ")}.`);

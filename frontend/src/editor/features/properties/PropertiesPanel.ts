@@ -16,7 +16,7 @@ import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
 import { quotedName } from "../../model/words";
 import { DURATION_EXAMPLES, parseDuration } from "../../model/timers";
-import { type CancelTarget, cancelsOf, parseCancels } from "../../model/cancels";
+import { cancelsOf, parseCancels } from "../../model/cancels";
 
 const MESSAGE_EXAMPLE = '{"name": "sync1", "correlation": {"case": "=case.id"}, "payload": {"cycle": "=data.cycle"}}';
 import { isLane, isNode, lanesTopDown, laneObject, nodeObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
@@ -173,18 +173,16 @@ export default class PropertiesPanel {
       placeholder: "nothing",
       hint: "Places and tasks of this net it empties when it fires (running tasks are cancelled): their ids, e.g. p3, tc2",
       commit: (text) => {
-        const ids = parseCancels(text, process, (id) => this.cancelTarget(id));
+        const ids = parseCancels(text, process, (id) => this.processOf(id));
         this.modeling.updateData(shape, { cancels: ids.length ? ids : undefined });
       },
     });
   }
 
-  private cancelTarget(id: string): CancelTarget | undefined {
+  /** The process of the node with this id; undefined when no node has it. */
+  private processOf(id: string): string | undefined {
     const element = this.elementRegistry.get(id);
-    if (!isNode(element)) return undefined;
-    const object = nodeObject(element);
-    const kind = object.kind === "place" ? "place" : object.silent ? "silent" : "task";
-    return { kind, process: object.process };
+    return isNode(element) ? nodeObject(element).process : undefined;
   }
 
   private laneSection(shape: Shape): void {
