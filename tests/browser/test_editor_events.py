@@ -19,7 +19,14 @@ from playwright.sync_api import Locator, Page, expect
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel
 from tests import factories
-from tests.browser.drawing import CHECKED, element_box, open_editor, select_element
+from tests.browser.drawing import (
+    CHECKED,
+    click_element,
+    element_box,
+    open_editor,
+    pattern_badge,
+    select_element,
+)
 from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
@@ -28,6 +35,41 @@ SignIn = Callable[[Page, User], None]
 Screenshot = Callable[[Page, str], Path]
 EXAMPLES = Path(__file__).resolve().parents[2] / "hrc" / "patterns" / "examples"
 CANCELLED = re.compile(r"\bhrc-cancelled\b")
+RUNNING = re.compile(r"\bhrc-running\b")
+# A drilling step with an interrupting timeout, as a BPMN boundary timer imports: t1 arms the
+# timeout (p3); tb fires after 5 minutes and cancels the drilling, running or not.
+TIMEOUT: dict[str, Any] = {
+    "format": "hrc-pattern/1",
+    "name": "Drilling with a timeout",
+    "actors": [{"id": "c", "type": "cobot", "program": "Drill"}],
+    "processes": [
+        {
+            "id": "N",
+            "workpiece": "plate",
+            "actors": ["c"],
+            "places": [{"id": f"p{n}", **({"tokens": 1} if n == 1 else {})} for n in range(1, 6)],
+            "transitions": [
+                {"id": "t1"},
+                {"id": "tc1", "performer": "c", "label": "drill"},
+                {"id": "t2"},
+                {"id": "tb", "label": "timeout", "timer": "PT5M", "cancels": ["p2", "tc1", "p4"]},
+            ],
+            "arcs": [
+                ["p1", "t1"],
+                ["t1", "p2"],
+                ["t1", "p3"],
+                ["p2", "tc1"],
+                ["tc1", "p4"],
+                ["p4", "t2"],
+                ["p3", "t2"],
+                ["t2", "p5"],
+                ["p3", "tb"],
+                ["tb", "p5"],
+            ],
+        }
+    ],
+    "constraints": [],
+}
 REWRITE = "The condition ${amount > limit} is JUEL, which hrc does not read: write it as a guard."
 
 
@@ -115,6 +157,37 @@ def test_a_condition_to_rewrite_holds_the_model_until_the_engineer_marks_it_rewr
     expect(page.locator(".hrc-toolbar .hrc-status")).to_have_text("Saved.", timeout=CHECKED)
     until(lambda: "rewrite" not in _transitions(pattern)["t1"])
     assert _transitions(pattern)["t1"]["guard"] == "data.amount > data.limit"
+
+
+def test_the_token_game_cancels_a_running_task_and_a_step_back_resumes_it(
+    page: Page,
+    live_url: str,
+    engineer: User,
+    organisation: Organisation,
+    sign_in: SignIn,
+) -> None:
+    pattern = factories.make_pattern(organisation, draft=TIMEOUT, name=TIMEOUT["name"])
+    sign_in(page, engineer)
+    open_editor(page, f"{live_url}/patterns/{pattern.pk}/edit/")
+    expect(page.locator('[data-element-id="tb"] .hrc-timer-duration')).to_have_text("5 min")
+    # Soundness holds only because tb cancels what it interrupts.
+    expect(pattern_badge(page)).to_have_attribute("data-sound", "true", timeout=CHECKED)
+    page.get_by_role("button", name="Token game").click()
+    bar = page.get_by_role("toolbar", name="Token game")
+    click_element(page, "t1")
+    click_element(page, "tc1")
+    expect(_element(page, "tc1")).to_have_class(RUNNING)
+
+    click_element(page, "tb")
+    expect(bar.locator(".hrc-game-caption")).to_contain_text("Fired: “timeout”")
+    expect(_element(page, "tc1")).not_to_have_class(RUNNING)
+    expect(page.locator('[data-element-id="p5"] .hrc-token')).to_have_count(1)
+    expect(page.locator(".djs-element .hrc-token")).to_have_count(1)
+
+    bar.get_by_role("button", name="↶ Undo firing").click()
+    expect(_element(page, "tc1")).to_have_class(RUNNING)
+    expect(page.locator('[data-element-id="p3"] .hrc-token')).to_have_count(1)
+    expect(page.locator('[data-element-id="p5"] .hrc-token')).to_have_count(0)
 
 
 def _commit(panel: Locator, label: str, value: str) -> None:
