@@ -23,6 +23,7 @@ import type { Api } from "./api";
 import CoreModule from "./core";
 import { isLane, isNode } from "./core/elements";
 import type PatternImporter from "./core/PatternImporter";
+import CancellationModule from "./features/cancellation";
 import CheckingModule from "./features/checking";
 import ConstraintsModule from "./features/constraints";
 import ContextPadModule from "./features/context-pad";
@@ -75,6 +76,7 @@ export const MODULES = [
   PaletteModule,
   ContextPadModule,
   ConstraintsModule,
+  CancellationModule,
   LabelEditingModule,
   KeyboardModule,
   CopyModule,

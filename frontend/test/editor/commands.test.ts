@@ -101,6 +101,15 @@ describe("element.updateId", () => {
     stack.undo();
     expect([place.id, place.businessObject.data.id]).toEqual(["p1", "p1"]);
   });
+
+  test("renaming a cancelled node renames it in the cancelling transition's list; undo puts it back", () => {
+    const task = register({ businessObject: { kind: "transition", process: "N", silent: false, data: { id: "tc1", performer: "c" } } });
+    const boundary = register({ businessObject: { kind: "transition", process: "N", silent: true, data: { id: "t9", cancels: ["p4", "tc1"] } } });
+    modeling.updateId(task, "drill");
+    expect((boundary.businessObject as TransitionObject).data.cancels).toEqual(["p4", "drill"]);
+    stack.undo();
+    expect((boundary.businessObject as TransitionObject).data.cancels).toEqual(["p4", "tc1"]);
+  });
 });
 
 describe("new elements", () => {

@@ -113,6 +113,46 @@ describe("the token game", () => {
   });
 });
 
+describe("a transition that cancels", () => {
+  /** p0 → t1 → p1 → to1 → p2, and t1 arms a boundary step tb that cancels to1 (its place and its run). */
+  function boundary(): ExecutionNet {
+    return readExecutionNet({
+      places: [
+        { id: "p0", tokens: 1 }, { id: "p1" }, { id: "armed" }, { id: "p2" },
+        { id: "running:to1", kind: "busy", of: "to1" },
+      ],
+      transitions: [
+        { id: "t1", kind: "silent", task: "t1" },
+        { id: "start:to1", kind: "start", task: "to1", performer: "o" },
+        { id: "complete:to1", kind: "complete", task: "to1", performer: "o" },
+        { id: "tb", kind: "silent", task: "tb", resets: ["p1", "running:to1"] },
+      ],
+      arcs: [["p0", "t1"], ["t1", "p1"], ["t1", "armed"], ["p1", "start:to1"], ["start:to1", "running:to1"], ["running:to1", "complete:to1"], ["complete:to1", "p2"], ["armed", "tb"], ["tb", "p2"]],
+    });
+  }
+
+  test("empties its reset places when it fires, a running task included", () => {
+    const game = new TokenGame(boundary());
+    expect(game.net.transitions.map((t) => t.resets)).toEqual([[], [], [], ["p1", "running:to1"]]);
+    for (const id of ["t1", "start:to1", "tb"]) game.fire(id);
+    expect(game.isRunning("to1")).toBe(false);
+    expect([...game.marking]).toEqual([["p2", 1]]);
+  });
+
+  test("a step back puts back what it took, and forward takes it again", () => {
+    const game = new TokenGame(boundary());
+    for (const id of ["t1", "start:to1", "tb"]) game.fire(id);
+    game.back();
+    expect(game.isRunning("to1")).toBe(true);
+    expect(new Map(game.marking)).toEqual(new Map([["running:to1", 1], ["armed", 1]]));
+    game.back();
+    game.fire("tb");
+    expect([...game.marking]).toEqual([["p2", 1]]);
+    game.back();
+    expect(new Map(game.marking)).toEqual(new Map([["p1", 1], ["armed", 1]]));
+  });
+});
+
 describe("a task held back by a constraint", () => {
   const names: Record<string, string> = { to1: "“Press the button”", tc1: "“Move part”" };
   const name = (id: string) => names[id] ?? id;

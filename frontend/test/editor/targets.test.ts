@@ -64,6 +64,14 @@ test("a process issue marks the process' lanes; a process without lanes marks no
   expect(ids("no-actors", ["N2"])).toEqual([]);
 });
 
+test("a condition to rewrite marks the imported transition or place that carries it", () => {
+  task("to1", "o");
+  register(factory.createShape({ id: "t4", businessObject: { kind: "transition", process: "N", silent: true, data: { id: "t4", rewrite: "JUEL ${x}" } } }));
+  register(factory.createShape({ id: "p2", businessObject: { kind: "place", process: "N", data: { id: "p2", rewrite: "loop" } } }));
+  expect(ids("to-rewrite", ["t4"])).toEqual(["t4"]);
+  expect(ids("to-rewrite", ["p2"])).toEqual(["p2"]);
+});
+
 test("an issue on other ids marks them alone, never the root", () => {
   task("to1", "o");
   expect(ids("unsound", ["to1", "__pattern", "gone"])).toEqual(["to1"]);

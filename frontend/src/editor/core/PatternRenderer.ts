@@ -1,8 +1,9 @@
 /**
  * Draws the pattern: places as circles with their tokens, tasks as boxes in
- * their actor's colours, silent transitions as black bars, actors as lanes
- * (cobots and operators look different), arcs as arrows and constraints as
- * dashed lines, one colour and marker per kind.
+ * their actor's colours, silent transitions as black bars (a clock and its
+ * duration under a timer's, a lightning bolt beside one that cancels), actors
+ * as lanes (cobots and operators look different), arcs as arrows and
+ * constraints as dashed lines, one colour and marker per kind.
  */
 
 import BaseRenderer from "diagram-js/lib/draw/BaseRenderer";
@@ -12,6 +13,8 @@ import type { Connection, Shape } from "diagram-js/lib/model/Types";
 
 import { type Element, LANE_HEADER, laneObject, nodeObject, objectOf, type ConstraintObject, type PlaceObject, type TransitionObject } from "./elements";
 import { svg, textBlock } from "./svg";
+import { cancelsOf } from "../model/cancels";
+import { timerWords } from "../model/timers";
 
 export const CONSTRAINT_STYLE: Record<string, { colour: string; dash: string; start: string; end: string; meaning: string }> = {
   time: { colour: "#1f5fbf", dash: "7 4", start: "", end: "arrow", meaning: "the second task starts after the first completes" },
@@ -94,6 +97,10 @@ export default class PatternRenderer extends BaseRenderer {
     const object = nodeObject(shape);
     const bar = svg("rect", { x: 0, y: 0, width: shape.width, height: shape.height, class: "hrc-silent", fill: "#1b1f24", stroke: "#1b1f24" }, parent);
     textBlock(parent, object.data.label || object.data.id, shape.width / 2, -9, { width: 90, size: 11, className: "hrc-text hrc-node-label", maxLines: 1 });
+    const timer = timerWords(object.data.timer);
+    if (timer) drawTimer(parent, shape, timer);
+    const cancels = cancelsOf(object.data);
+    if (cancels.length) drawCancels(parent, shape, cancels);
     return bar;
   }
 
@@ -155,6 +162,25 @@ function drawTokens(parent: SVGElement, tokens: number, r: number): void {
   }
   const count = svg("text", { x: r, y: r + 1, "text-anchor": "middle", "dominant-baseline": "middle", "font-size": 14, "font-weight": 700, class: "hrc-text hrc-token-count" }, parent);
   count.textContent = String(tokens);
+}
+
+/** A clock under the bar, its duration beneath; the tooltip says when the transition fires. */
+function drawTimer(parent: SVGElement, shape: Shape, words: string): void {
+  const x = shape.width / 2;
+  const y = shape.height + 11;
+  const clock = svg("g", { class: "hrc-timer-mark", fill: "#fff", stroke: "#1b1f24", "stroke-width": 1.5 }, parent);
+  svg("circle", { cx: x, cy: y, r: 8 }, clock);
+  svg("path", { d: `M${x},${y - 5} V${y} L${x + 4},${y + 2}`, fill: "none", "stroke-linecap": "round" }, clock);
+  svg("title", {}, clock).textContent = `Timer: fires once enabled for ${words} without interruption`;
+  const text = svg("text", { x, y: y + 20, "text-anchor": "middle", "font-size": 11, class: "hrc-text hrc-timer-duration" }, parent);
+  text.textContent = words;
+}
+
+/** A lightning bolt at the bar's top right; the tooltip names what it cancels. */
+function drawCancels(parent: SVGElement, shape: Shape, cancels: string[]): void {
+  const mark = svg("g", { class: "hrc-cancels-mark", transform: `translate(${shape.width + 2} 0)` }, parent);
+  svg("path", { d: "M7,0 L1,9 H5 L3,17 L11,6 H7 L9,0 z", fill: "#b42318", stroke: "#fff", "stroke-width": 0.8, "stroke-linejoin": "round" }, mark);
+  svg("title", {}, mark).textContent = `Cancels ${cancels.join(", ")} when it fires`;
 }
 
 /** A small robot arm for cobots, a person for operators. */

@@ -26,6 +26,8 @@ export interface NetTransition {
   task: string;
   /** The actor who performs the task; null for a silent step. */
   performer: string | null;
+  /** Places emptied when it fires, after its input is taken (a `cancels` key; `running:t` cancels task t). */
+  resets: string[];
 }
 
 export interface ExecutionNet {
@@ -52,7 +54,8 @@ export function readExecutionNet(value: unknown): ExecutionNet {
     const kind = (["start", "complete", "silent"].includes(String(transition.kind)) ? transition.kind : id.includes(":") ? id.split(":")[0] : "silent") as FiringKind;
     const task = String(transition.task ?? (id.includes(":") ? id.split(":").slice(1).join(":") : id));
     const performer = typeof transition.performer === "string" ? transition.performer : null;
-    return { id, label: String(transition.label ?? (kind === "silent" ? task : `${kind} ${task}`)), kind, task, performer };
+    const resets = Array.isArray(transition.resets) ? transition.resets.map(String) : [];
+    return { id, label: String(transition.label ?? (kind === "silent" ? task : `${kind} ${task}`)), kind, task, performer, resets };
   });
   const arcs = (Array.isArray(value.arcs) ? value.arcs : []).flatMap((arc): [string, string][] => {
     if (Array.isArray(arc) && arc.length >= 2) {
@@ -94,6 +97,8 @@ export class TokenGame {
   private readonly pre = new Map<string, Map<string, number>>();
   private readonly post = new Map<string, Map<string, number>>();
   private readonly byId: Map<string, NetTransition>;
+  /** Per firing in `history`, the tokens its resets took, so a step back puts them back. */
+  private readonly taken: Marking[] = [];
 
   constructor(net: ExecutionNet) {
     this.net = net;
@@ -135,7 +140,7 @@ export class TokenGame {
   back(): boolean {
     const last = this.history.pop();
     if (!last) return false;
-    this.shift(last, -1);
+    this.unfire(last, this.taken.pop() ?? new Map<string, number>());
     this.future.unshift(last);
     return true;
   }
@@ -152,6 +157,7 @@ export class TokenGame {
   reset(): void {
     this.marking = this.initialMarking();
     this.history.length = 0;
+    this.taken.length = 0;
     this.future = [];
   }
 
@@ -214,15 +220,24 @@ export class TokenGame {
     const transition = this.byId.get(id);
     if (!transition) throw new Error(`There is no transition ${id} in the execution net.`);
     if (!this.isEnabled(transition)) throw new Error(`${transition.label} is not enabled.`);
-    this.shift(transition, 1);
+    for (const [place, weight] of this.pre.get(id) ?? []) this.bump(place, -weight);
+    const taken: Marking = new Map();
+    for (const place of transition.resets) {
+      const tokens = this.tokens(place);
+      if (tokens > 0) taken.set(place, tokens);
+      this.bump(place, -tokens);
+    }
+    for (const [place, weight] of this.post.get(id) ?? []) this.bump(place, weight);
     this.history.push(transition);
+    this.taken.push(taken);
     return transition;
   }
 
-  /** Fires (direction 1) or unfires (-1) a transition on the marking. */
-  private shift(transition: NetTransition, direction: 1 | -1): void {
-    for (const [place, weight] of this.pre.get(transition.id) ?? []) this.bump(place, -direction * weight);
-    for (const [place, weight] of this.post.get(transition.id) ?? []) this.bump(place, direction * weight);
+  /** Takes a firing back: its output, then what its resets took, then its input. */
+  private unfire(transition: NetTransition, taken: Marking): void {
+    for (const [place, weight] of this.post.get(transition.id) ?? []) this.bump(place, -weight);
+    for (const [place, tokens] of taken) this.bump(place, tokens);
+    for (const [place, weight] of this.pre.get(transition.id) ?? []) this.bump(place, weight);
   }
 
   private bump(place: string, delta: number): void {

@@ -1,7 +1,8 @@
 /**
  * `element.updateId`: renames a node or an actor. The element id is the
  * document id, so the registry, the document object, the tasks an actor
- * performs and the processes that list the actor all follow.
+ * performs, the processes that list the actor and the transitions that cancel
+ * the node all follow.
  */
 
 import type Canvas from "diagram-js/lib/core/Canvas";
@@ -9,7 +10,8 @@ import type ElementRegistry from "diagram-js/lib/core/ElementRegistry";
 import type { CommandContext } from "diagram-js/lib/command/CommandStack";
 import type { ElementLike } from "diagram-js/lib/core/Types";
 
-import { nodeObject, objectOf, performerOf, type RootObject } from "../../core/elements";
+import { isSilent, nodeObject, objectOf, performerOf, type RootObject } from "../../core/elements";
+import { renamedCancels } from "../../model/cancels";
 
 export interface UpdateIdContext extends CommandContext {
   element: ElementLike;
@@ -50,6 +52,12 @@ export default class UpdateIdHandler {
       }
     } else if (object?.kind === "place" || object?.kind === "transition") {
       object.data.id = to;
+      for (const transition of this.elementRegistry.filter(isSilent)) {
+        const cancels = renamedCancels(nodeObject(transition).data, from, to);
+        if (!cancels) continue;
+        nodeObject(transition).data.cancels = cancels;
+        changed.push(transition);
+      }
     }
     return changed;
   }

@@ -15,9 +15,11 @@ import { idProblem } from "../../model/ids";
 import { performerRefusal } from "../../model/rules";
 import { CONSTRAINT_TYPES } from "../../model/document";
 import { quotedName } from "../../model/words";
+import { DURATION_EXAMPLES, parseDuration } from "../../model/timers";
+import { cancelsOf, parseCancels } from "../../model/cancels";
 
 const MESSAGE_EXAMPLE = '{"name": "sync1", "correlation": {"case": "=case.id"}, "payload": {"cycle": "=data.cycle"}}';
-import { isLane, lanesTopDown, laneObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
+import { isLane, isNode, lanesTopDown, laneObject, nodeObject, objectOf, type ConstraintObject, type PatternObject, type RootObject } from "../../core/elements";
 import type PatternElementFactory from "../../core/PatternElementFactory";
 import type PatternModeling from "../modeling/PatternModeling";
 import { addElement } from "../../../shared/dom";
@@ -86,6 +88,7 @@ export default class PropertiesPanel {
   private nodeSection(shape: Shape, object: PatternObject & { kind: "place" | "transition" }): void {
     const silent = object.kind === "transition" && object.silent;
     heading(this.panel, object.kind === "place" ? "Place" : silent ? "Silent transition" : "Task");
+    if (typeof object.data.rewrite === "string") this.rewriteNote(shape, object.data.rewrite);
     this.idField(shape);
     field(this.panel, { label: "Label", value: String(object.data.label ?? ""), commit: (text) => this.modeling.updateLabel(shape, text) });
     if (object.kind === "place") {
@@ -100,6 +103,8 @@ export default class PropertiesPanel {
       field(this.panel, { label: "Guard", value: String(object.data.guard ?? ""), hint: "Fires only when this expression over data holds, e.g. data.count > 3", commit: (text) => this.modeling.updateData(shape, { guard: text.trim() || undefined }) });
       this.messageField(shape, "message", "Waits for a message", '{"name": "sync1", "correlation": {"case": "=case.id"}}');
       this.messageField(shape, "send", "Sends a message when it fires", MESSAGE_EXAMPLE);
+      this.timerField(shape, object.data.timer);
+      this.cancelsField(shape, object.process, object.data);
       return;
     }
     const performer = String(object.data.performer ?? "");
@@ -135,6 +140,49 @@ export default class PropertiesPanel {
       if (typeof parsed !== "object" || parsed === null || Array.isArray(parsed)) throw new Error("Write an object with a \"name\", such as the example.");
       this.modeling.updateData(shape, { [key]: parsed });
     } });
+  }
+
+  /** What an import could not translate, until the engineer says they rewrote it: the check
+   * holds the model back as a draft (`to-rewrite`) while the key is there. */
+  private rewriteNote(shape: Shape, text: string): void {
+    const box = addElement(this.panel, "div", { class: "hrc-rewrite", role: "note", "aria-label": "To rewrite" });
+    addElement(box, "h4", "").textContent = "To rewrite";
+    addElement(box, "p", "hrc-rewrite-text").textContent = text;
+    const done = button(box, "Rewritten", () => this.modeling.updateData(shape, { rewrite: undefined }));
+    done.title = "You rewrote this as the note asks: the note goes, and with it the check's error";
+  }
+
+  private timerField(shape: Shape, timer: unknown): void {
+    field(this.panel, {
+      label: "Timer",
+      value: typeof timer === "string" ? timer : "",
+      placeholder: "no timer",
+      hint: `Fires once enabled this long without interruption: an ISO 8601 duration, e.g. ${DURATION_EXAMPLES}`,
+      commit: (text) => {
+        const written = text.trim().toUpperCase();
+        if (written) parseDuration(written);
+        this.modeling.updateData(shape, { timer: written || undefined });
+      },
+    });
+  }
+
+  private cancelsField(shape: Shape, process: string, data: Record<string, unknown>): void {
+    field(this.panel, {
+      label: "Cancels",
+      value: cancelsOf(data).join(", "),
+      placeholder: "nothing",
+      hint: "Places and tasks of this net it empties when it fires (running tasks are cancelled): their ids, e.g. p3, tc2",
+      commit: (text) => {
+        const ids = parseCancels(text, process, (id) => this.processOf(id));
+        this.modeling.updateData(shape, { cancels: ids.length ? ids : undefined });
+      },
+    });
+  }
+
+  /** The process of the node with this id; undefined when no node has it. */
+  private processOf(id: string): string | undefined {
+    const element = this.elementRegistry.get(id);
+    return isNode(element) ? nodeObject(element).process : undefined;
   }
 
   private laneSection(shape: Shape): void {
