@@ -49,6 +49,8 @@ def translate(text: str, language: str | None = None) -> str | None:
         return None
     wrapped = _WRAPPED.match(text)
     body = wrapped.group("body") if wrapped else text
+    if check(body.strip(), ["data"]) is None:
+        return body.strip()  # hrc's own language, as our export writes it
     words = _tokens(body)
     if not words:
         return None

@@ -236,7 +236,8 @@ class ProcessReader:
         if element.get("isForCompensation") == "true":
             self.reading.fail(
                 f"The {what} compensates another activity: compensation is not imported; "
-                "draw the undoing steps as ordinary tasks on an error path."
+                "draw the undoing steps as ordinary tasks on an error path.",
+                xml_id,
             )
             return None
         if local in REFUSED_WHY:
