@@ -58,7 +58,7 @@ from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-igno
     iterparse as _safe_iterparse,
 )
 
-from hrc.engine.bpmn_net import FlowNet, Scope, describe
+from hrc.engine.bpmn_net import FlowNet, describe
 from hrc.engine.bpmn_scopes import FLOW_NODE_KINDS, GLOBAL_TASKS, ProcessGraph, ProcessReader
 from hrc.engine.bpmn_xml import BPMN_NAMESPACE, HRC_NAMESPACE
 from hrc.engine.bpmn_xml import bpmn_name as _bpmn
@@ -290,7 +290,10 @@ class _Importer:
             xml_id = child.get("id", "")
             if local == "process":
                 self.processes[xml_id] = child
-                if any(_bpmn(node) in FLOW_NODE_KINDS | {"subProcess", "callActivity"} for node in child):
+                if any(
+                    _bpmn(node) in FLOW_NODE_KINDS | {"subProcess", "callActivity"}
+                    for node in child
+                ):
                     processes.append(child)
             elif local == "collaboration":
                 collaborations.append(child)
@@ -360,9 +363,9 @@ class _Importer:
 
     def _refuse_element(self, element: ET.Element, local: str) -> None:
         xml_id = element.get("id", "")
-        why = REFUSED_WHY.get(local, "hrc does not map this BPMN element")
+        what = describe(local, xml_id or "(without id)", element.get("name"))
         self.fail(
-            f"The <{local}> {xml_id or '(without id)'} cannot be imported: {why}.",
+            f"The {what} cannot be imported: hrc does not map <{local}> here.",
             *([xml_id] if xml_id else []),
         )
 

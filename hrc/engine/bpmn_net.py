@@ -296,36 +296,38 @@ class FlowNet:
         into = self._merged_input(node)
         count, sequential = node.copies
         if count > 1:
-            into = self._copies(node, into, performer, count, sequential, extra)
-            step = None
+            after = self._copies(node, into, performer, count, sequential, extra)
         else:
-            step = self._step(node, node.hrc_id, performer=performer, label=label, extra=extra)
+            after = self._step(node, node.hrc_id, performer=performer, label=label, extra=extra)
             if into is not None:
-                self.arc(into, step)
-        after = into if step is None else step
-        if node.loop is not None:
-            done = self.place(self.fresh(f"{node.hrc_id}_done"), node.scope)
-            self.arc(after, done)
-            back = self.transition(
-                self.fresh(f"{node.hrc_id}_again"),
-                node.scope,
-                label=f"{node.name or node.hrc_id}: again",
-                extra=node.loop,
-            )
-            self.arc(done, back)
-            assert node.incoming or into is not None
-            self.arc(back, into or "")
-            guard = node.loop.get("guard")
-            after = self.transition(
-                self.fresh(f"{node.hrc_id}_exit"),
-                node.scope,
-                guard=f"not ({guard})" if guard else None,
-            )
-            self.arc(done, after)
+                self.arc(into, after)
+        if node.loop is not None and into is not None:
+            after = self._loop(node, into, after)
         # Several flows out of an activity all get a token: a parallel split, no step needed.
         for flow in node.outgoing:
-            if after is not None:
-                self.arc(after, flow.place)
+            self.arc(after, flow.place)
+
+    def _loop(self, node: FlowNode, into: str, last: str) -> str:
+        """A standard loop: after the activity, a step back to its input or one out; returns it."""
+        loop = node.loop or {}
+        done = self.place(self.fresh(f"{node.hrc_id}_done"), node.scope)
+        self.arc(last, done)
+        back = self.transition(
+            self.fresh(f"{node.hrc_id}_again"),
+            node.scope,
+            label=f"{node.name or node.hrc_id}: again",
+            extra=loop,
+        )
+        self.arc(done, back)
+        self.arc(back, into)
+        guard = loop.get("guard")
+        leave = self.transition(
+            self.fresh(f"{node.hrc_id}_exit"),
+            node.scope,
+            guard=f"not ({guard})" if guard else None,
+        )
+        self.arc(done, leave)
+        return leave
 
     def _copies(
         self,
@@ -490,7 +492,9 @@ class FlowNet:
                     self.arc(step, scope.sink)
 
 
-def _subset_guard(guards: dict[str, str | None], chosen: set[str], default: str | None) -> str | None:
+def _subset_guard(
+    guards: dict[str, str | None], chosen: set[str], default: str | None
+) -> str | None:
     """The guard of taking exactly the chosen branches of an inclusive split."""
     parts = []
     for flow_id, guard in guards.items():

@@ -80,7 +80,9 @@ CORRELATION_SEND = {"case": "=case.id"}
 CORRELATION_AWAIT = {"case": "case.id"}
 MAX_COPIES = 20
 """Multi-instance copies made at import; a larger cardinality is imported once, to rewrite."""
-DURATION = re.compile(r"^P(?!$)(\d+(\.\d+)?D)?(T(?=\d)(\d+(\.\d+)?H)?(\d+(\.\d+)?M)?(\d+(\.\d+)?S)?)?$")
+DURATION = re.compile(
+    r"^P(?!$)(\d+(\.\d+)?D)?(T(?=\d)(\d+(\.\d+)?H)?(\d+(\.\d+)?M)?(\d+(\.\d+)?S)?)?$"
+)
 
 
 class Reading(Protocol):
@@ -165,19 +167,30 @@ class ProcessReader:
         self.begins: dict[str, FlowNode] = {}
         """Scope id -> the step that begins it."""
         self._finishes: dict[str, FlowNode] = {}
+        self._entered_by: dict[int, Scope] = {}
+        """id() of a scope's begin step -> the scope, for boundary events attached to it."""
 
     def read(self) -> ProcessGraph:
         self._container(self.element, self.graph.root, "", None)
         self._route_throws()
         self._links()
         self._inclusive_blocks()
+        self._deferred_choices()
         return self.graph
+
+    def _deferred_choices(self) -> None:
+        """An event-based gateway's outgoing flows share one place: its events race for it."""
+        for gateway in self.graph.nodes:
+            if gateway.kind != "eventBasedGateway":
+                continue
+            single = len(gateway.incoming) == 1
+            centre = gateway.incoming[0].place if single else gateway.hrc_id
+            for flow in gateway.outgoing:
+                flow.place = centre
 
     # Containers: the process, sub-processes, called processes.
 
-    def _container(
-        self, element: ET.Element, scope: Scope, prefix: str, outer: str | None
-    ) -> None:
+    def _container(self, element: ET.Element, scope: Scope, prefix: str, outer: str | None) -> None:
         """Reads the flow nodes and flows of a process or sub-process into the scope."""
         entry: dict[str, FlowNode] = {}
         exit_: dict[str, FlowNode] = {}
@@ -268,10 +281,9 @@ class ProcessReader:
             self.graph.tasks[node.hrc_id] = outer or xml_id
             self._task_messages(node)
             self._loops(element, node)
-        elif local in EVENT_KINDS:
-            if not self._event(element, node):
-                self.refused.add(xml_id)
-                return None
+        elif local in EVENT_KINDS and not self._event(element, node):
+            self.refused.add(xml_id)
+            return None
         if local == "inclusiveGateway":
             node.keys.setdefault("bpmn", "inclusiveGateway")
         return node, node
@@ -295,7 +307,9 @@ class ProcessReader:
             else:
                 contents = resolved  # type: ignore[assignment]
                 inner_prefix = f"{prefix}{self.reading.hrc_id(xml_id)}."
-        elif not any(bpmn_name(c) in FLOW_NODE_KINDS | {"subProcess", "callActivity"} for c in element):
+        elif not any(
+            bpmn_name(c) in FLOW_NODE_KINDS | {"subProcess", "callActivity"} for c in element
+        ):
             contents = None
         hrc_id = prefix + self.reading.hrc_id(xml_id)
         if contents is None:
@@ -335,6 +349,7 @@ class ProcessReader:
         )
         self.graph.scopes[hrc_id] = inner
         self.begins[hrc_id], self._finishes[hrc_id] = begin, finish
+        self._entered_by[id(begin)] = inner
         begin.post += [inner.source, inner.place or ""]
         finish.pre += [inner.sink, inner.place or ""]
         finish.cancels_places = inner.armed
@@ -405,10 +420,13 @@ class ProcessReader:
             )
             self.refused.add(xml_id)
             return None
-        inner = self.graph.scopes.get(host.hrc_id) if host.kind == "begin" else None
+        inner = self._entered_by.get(id(host))
         if inner is None:
             inner = self._task_scope(host)
-            entry[attached], exit_[attached] = self.begins[inner.hrc_id], self._finishes[inner.hrc_id]
+            entry[attached], exit_[attached] = (
+                self.begins[inner.hrc_id],
+                self._finishes[inner.hrc_id],
+            )
         interrupting = element.get("cancelActivity", "true") != "false"
         node.pre.append(inner.place or "")
         if interrupting:
@@ -458,14 +476,21 @@ class ProcessReader:
             if not xml_id:
                 self.reading.fail(f"A sequence flow in {element.get('id', 'a process')} has no id.")
                 continue
-            source_ref, target_ref = flow_element.get("sourceRef", ""), flow_element.get("targetRef", "")
+            source_ref, target_ref = (
+                flow_element.get("sourceRef", ""),
+                flow_element.get("targetRef", ""),
+            )
             if source_ref in self.refused or target_ref in self.refused:
                 continue  # its end was refused, and said so
             source, target = exit_.get(source_ref), entry.get(target_ref)
             name = (flow_element.get("name") or "").strip() or None
             what = describe("sequenceFlow", xml_id, name)
             if source is None or target is None:
-                missing = [r or "(nothing)" for r, n in ((source_ref, source), (target_ref, target)) if n is None]
+                missing = [
+                    r or "(nothing)"
+                    for r, n in ((source_ref, source), (target_ref, target))
+                    if n is None
+                ]
                 self.reading.fail(
                     f"The {what} names {', '.join(missing)}, which is no flow node here.", xml_id
                 )
@@ -536,32 +561,49 @@ class ProcessReader:
         starts: list[FlowNode],
         ends: list[FlowNode],
     ) -> None:
-        """BPMN lets a scope without start (end) events start (end) at nodes with no flow in (out)."""
+        """Implicit starts and ends: BPMN lets a scope without start events start at its
+        nodes with no flow in, and a node with no flow out end its path."""
         nodes = list(dict.fromkeys([*entry.values(), *exit_.values()]))
         if not starts:
             first = [
                 n
                 for n in dict.fromkeys(entry.values())
-                if not n.incoming and n.kind not in ("boundaryEvent", "endEvent") and not n.pre
+                if not n.incoming
+                and n.kind not in ("boundaryEvent", "endEvent")
+                and not n.pre
                 and not (n.kind == "intermediateCatchEvent" and n.keys.get("bpmn") == "link")
             ]
             if first:
-                start = self._node("startEvent", scope.hrc_id, self.reading.fresh(f"{scope.hrc_id}_begin"), None, scope)
+                start = self._node(
+                    "startEvent",
+                    scope.hrc_id,
+                    self.reading.fresh(f"{scope.hrc_id}_begin"),
+                    None,
+                    scope,
+                )
                 for node in first:
                     self.synthetic_flow(start, node, scope)
                 starts.append(start)
-        if not ends:
-            last = [
-                n
-                for n in nodes
-                if not n.outgoing and n.kind not in ("startEvent", "endEvent") and not n.post
-                and not (n.kind == "intermediateThrowEvent" and n.keys.get("bpmn") == "link")
-            ]
-            if last:
-                end = self._node("endEvent", scope.hrc_id, self.reading.fresh(f"{scope.hrc_id}_complete"), None, scope)
-                for node in last:
-                    self.synthetic_flow(node, end, scope)
-                ends.append(end)
+        # A node with no flow out ends its path, end events or not (BPMN's implicit end).
+        last = [
+            n
+            for n in nodes
+            if not n.outgoing
+            and n.kind not in ("startEvent", "endEvent")
+            and not n.post
+            and not (n.kind == "intermediateThrowEvent" and n.keys.get("bpmn") == "link")
+        ]
+        if last:
+            end = self._node(
+                "endEvent",
+                scope.hrc_id,
+                self.reading.fresh(f"{scope.hrc_id}_complete"),
+                None,
+                scope,
+            )
+            for node in last:
+                self.synthetic_flow(node, end, scope)
+            ends.append(end)
 
     # Events.
 
@@ -698,15 +740,25 @@ class ProcessReader:
         if loop is not None:
             condition = next(iter(children(loop, "loopCondition")), None)
             text = text_of(condition)
-            guard = translate(text, condition.get("language") if condition is not None else None) if text else None
+            guard = (
+                translate(text, condition.get("language") if condition is not None else None)
+                if text
+                else None
+            )
             if node.kind == "begin":
-                node.keys["rewrite"] = f"The {what} loops: a looping sub-process is imported once; draw the loop with an exclusive gateway."
+                node.keys["rewrite"] = (
+                    f"The {what} loops: a looping sub-process is imported once; draw the loop with an exclusive gateway."
+                )
             elif guard is not None:
                 node.loop = {"guard": guard}
             else:
                 node.loop = {
                     "rewrite": f"The {what} loops "
-                    + (f"while {text[:200]!r}, which did not translate" if text else "without a condition")
+                    + (
+                        f"while {text[:200]!r}, which did not translate"
+                        if text
+                        else "without a condition"
+                    )
                     + ": write the guard of repeating it."
                 }
         multiple = next(iter(children(element, "multiInstanceLoopCharacteristics")), None)
@@ -717,7 +769,11 @@ class ProcessReader:
         if cardinality.isdigit() and 1 <= int(cardinality) <= MAX_COPIES and node.kind != "begin":
             node.copies = (int(cardinality), sequential)
             return
-        how = f"{cardinality[:200]!r} times" if cardinality else "a number of times known only at run time"
+        how = (
+            f"{cardinality[:200]!r} times"
+            if cardinality
+            else "a number of times known only at run time"
+        )
         node.keys["rewrite"] = (
             f"The {what} runs {how} ({'in sequence' if sequential else 'in parallel'}): it is "
             "imported once; draw its copies."
@@ -745,7 +801,11 @@ class ProcessReader:
             else:
                 thrower.post_flows = boundary.node.outgoing
         for boundary in self.boundaries:
-            if boundary.caught and boundary.trigger is not None and boundary.trigger.kind in ("error", "escalation"):
+            if (
+                boundary.caught
+                and boundary.trigger is not None
+                and boundary.trigger.kind in ("error", "escalation")
+            ):
                 boundary.node.keys.pop("message", None)
                 boundary.node.kind = "caughtBoundaryEvent"
 
@@ -768,17 +828,23 @@ class ProcessReader:
             target = catches.get(name)
             if target is None:
                 self.reading.fail(
-                    f"The {node.describe()} jumps to link {name!r}, which no catch event names."
-                    , node.xml_id
+                    f"The {node.describe()} jumps to link {name!r}, which no catch event names.",
+                    node.xml_id,
                 )
                 continue
             self.synthetic_flow(node, target, node.scope)
 
     def _inclusive_blocks(self) -> None:
         """Finds each inclusive split's join: the inclusive gateway every branch reaches first."""
-        joins = {n.xml_id for n in self.graph.nodes if n.kind == "inclusiveGateway" and len(n.incoming) > 1}
+        joins = {
+            n.xml_id
+            for n in self.graph.nodes
+            if n.kind == "inclusiveGateway" and len(n.incoming) > 1
+        }
         claimed: set[str] = set()
-        for split in [n for n in self.graph.nodes if n.kind == "inclusiveGateway" and len(n.outgoing) > 1]:
+        for split in [
+            n for n in self.graph.nodes if n.kind == "inclusiveGateway" and len(n.outgoing) > 1
+        ]:
             if len(split.outgoing) > MAX_INCLUSIVE_BRANCHES:
                 self.reading.fail(
                     f"The {split.describe()} has {len(split.outgoing)} branches; inclusive "
@@ -791,7 +857,9 @@ class ProcessReader:
             if not any(reached):
                 continue  # the branches never meet again: no join to tell
             candidates = [j for j in reached[0] if j in common]
-            join = next((n for n in self.graph.nodes if candidates and n.xml_id == candidates[0]), None)
+            join = next(
+                (n for n in self.graph.nodes if candidates and n.xml_id == candidates[0]), None
+            )
             mapping = self._branch_flows(split, join) if join is not None else None
             if join is None or mapping is None:
                 self.reading.fail(

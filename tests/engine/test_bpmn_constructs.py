@@ -75,7 +75,9 @@ def test_a_juel_condition_becomes_a_guard_that_routes_the_case() -> None:
         + flows("f1: s -> x", "low: x -> small", "f2: big -> m", "f3: small -> m", "f4: m -> e")
     )
     pattern = bpmn_to_pattern(text)
-    assert _transition(pattern, "x_high").extra["guard"] == "data.amount > 1000 and not data.blocked"
+    assert (
+        _transition(pattern, "x_high").extra["guard"] == "data.amount > 1000 and not data.blocked"
+    )
     assert _run(pattern, {"amount": 5000, "blocked": False}) == ["big"]
     assert _run(pattern, {"amount": 5, "blocked": False}) == ["small"]
 
