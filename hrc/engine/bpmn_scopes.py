@@ -533,11 +533,13 @@ class ProcessReader:
             )
 
     def _conditional_flows(self, scope: Scope) -> None:
-        """Conditions on flows out of a task or event: a silent choice after it."""
+        """Conditions (or a default flow) on flows out of a task or event: a silent choice after it."""
         for node in [n for n in self.graph.nodes if n.scope is scope]:
             if node.kind in GATEWAY_KINDS:
                 continue
-            if not any(f.guard or f.rewrite for f in node.outgoing):
+            # A default flow only makes sense beside conditional ones, even if theirs were left empty.
+            has_default = any(f.xml_id == node.default for f in node.outgoing)
+            if not has_default and not any(f.guard or f.rewrite for f in node.outgoing):
                 continue
             choice = self._node(
                 "exclusiveGateway",
