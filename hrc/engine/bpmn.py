@@ -466,6 +466,11 @@ class _Importer:
     def signal_thrown(self, name: str) -> bool:
         return name in self.signals_thrown
 
+    def event_definition(self, xml_id: str) -> ET.Element | None:
+        element = self.elements.get(xml_id)
+        local = _bpmn(element) if element is not None else None
+        return element if local and local.endswith("EventDefinition") else None
+
     # Lanes and actors.
 
     def _lanes(

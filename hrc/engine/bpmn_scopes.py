@@ -108,6 +108,8 @@ class Reading(Protocol):
 
     def signal_thrown(self, name: str) -> bool: ...
 
+    def event_definition(self, xml_id: str) -> ET.Element | None: ...
+
 
 @dataclass
 class Trigger:
@@ -610,7 +612,14 @@ class ProcessReader:
     # Events.
 
     def _trigger(self, element: ET.Element, node: FlowNode) -> Trigger | None:
-        for child in element:
+        for given in element:
+            child = given
+            if bpmn_name(given) == "eventDefinitionRef":
+                # A definition at the file's root, shared by several events.
+                shared = self.reading.event_definition(text_of(given))
+                if shared is None:
+                    return Trigger("reference", given, text_of(given))
+                child = shared
             local = bpmn_name(child) or ""
             if local.endswith("EventDefinition"):
                 kind = local.removesuffix("EventDefinition")
@@ -624,8 +633,6 @@ class ProcessReader:
                 if kind == "link":
                     name = child.get("name") or node.name
                 return Trigger(kind, child, name)
-            if local == "eventDefinitionRef":
-                return Trigger("reference", child, None)
         return None
 
     def _event(self, element: ET.Element, node: FlowNode) -> bool:
@@ -634,10 +641,17 @@ class ProcessReader:
         what = node.describe()
         if trigger is None:
             return True
-        if trigger.kind in ("compensate", "cancel", "reference"):
+        if trigger.kind == "reference":
             self.reading.fail(
-                f"The {what} has a {trigger.kind} definition: compensation, cancellation and "
-                "shared event definitions are not imported.",
+                f"The {what} refers to event definition {trigger.name!r}, which this file does "
+                "not define.",
+                node.xml_id,
+            )
+            return False
+        if trigger.kind in ("compensate", "cancel"):
+            self.reading.fail(
+                f"The {what} has a {trigger.kind} event definition: compensation and "
+                "cancellation are not imported.",
                 node.xml_id,
             )
             return False
