@@ -58,7 +58,7 @@ from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-igno
     iterparse as _safe_iterparse,
 )
 
-from hrc.engine.bpmn_net import FlowNet, describe
+from hrc.engine.bpmn_net import FlowNet, Scope, describe
 from hrc.engine.bpmn_scopes import FLOW_NODE_KINDS, GLOBAL_TASKS, ProcessGraph, ProcessReader
 from hrc.engine.bpmn_xml import BPMN_NAMESPACE, HRC_NAMESPACE
 from hrc.engine.bpmn_xml import bpmn_name as _bpmn
@@ -389,6 +389,8 @@ class _Importer:
         performers = self._lanes(element, graph, pool, process_id)
         for node in graph.nodes:
             net.add(node, performers.get(node.hrc_id))
+        for scope, call_id, pattern in graph.inlined:
+            performers.update(self._inline(net, scope, call_id, pattern))
         for scope_id, scope in graph.scopes.items():
             net.ends(graph.starts.get(scope_id, []), scope, start=True)
             net.ends(graph.ends.get(scope_id, []), scope, start=False)
@@ -439,6 +441,54 @@ class _Importer:
             for place in (scope.source, scope.sink, *scope.armed):
                 net.place(place, scope)
             net.place(scope.place or "", scope.parent or root)
+
+    def _inline(self, net: FlowNet, scope: Scope, call_id: str, pattern: Pattern) -> dict[str, str]:
+        """Copies a called pattern's net into the call activity's scope; returns task -> actor.
+
+        Its source and sink places become the scope's; every other id and its
+        actors get the call activity's id in front, and its constraints come along.
+        """
+        process = pattern.processes[0]
+        ids: dict[str, str] = {}
+        ids.update(dict.fromkeys(process.source_places()[:1], scope.source))
+        ids.update(dict.fromkeys(process.sink_places()[:1], scope.sink))
+        for element_id in [p.id for p in process.places] + [t.id for t in process.transitions]:
+            ids.setdefault(element_id, self.fresh(f"{call_id}.{element_id}"))
+        actors: dict[str, str] = {}
+        for actor in pattern.actors:
+            actors[actor.id] = self.fresh(f"{call_id}.{actor.id}")
+            self.actors[actors[actor.id]] = {
+                "id": actors[actor.id],
+                "type": actor.type,
+                **actor.extra,
+            }
+        for place in process.places:
+            net.place(ids[place.id], scope, **place.extra)
+        performers: dict[str, str] = {}
+        for transition in process.transitions:
+            performer = actors.get(transition.performer or "")
+            net.transition(
+                ids[transition.id],
+                scope,
+                performer=performer,
+                label=transition.label,
+                extra=dict(transition.extra),
+            )
+            if performer is not None:
+                performers[ids[transition.id]] = performer
+        for source, target in process.arcs:
+            net.arc(ids[source], ids[target])
+        for constraint in pattern.constraints:
+            if constraint.source in ids and constraint.target in ids:
+                self.constraints.append(
+                    {
+                        "from": ids[constraint.source],
+                        "to": ids[constraint.target],
+                        "type": constraint.type,
+                        **constraint.extra,
+                    }
+                )
+        return performers
 
     # What the process reader asks.
 

@@ -26,6 +26,7 @@ from hrc.engine.bpmn_net import (
     describe,
 )
 from hrc.engine.bpmn_xml import bpmn_name, children, text_of
+from hrc.engine.model import Pattern
 
 Json = dict[str, Any]
 
@@ -133,8 +134,8 @@ class ProcessGraph:
     scopes: dict[str, Scope] = field(default_factory=dict)
     tasks: dict[str, str] = field(default_factory=dict)
     """hrc id of each task -> the XML id its lane is looked up by."""
-    source_names: dict[str, Json] = field(default_factory=dict)
-    """Source or sink place -> the keys of the single event it stands for."""
+    inlined: list[tuple[Scope, str, Pattern]] = field(default_factory=list)
+    """Published patterns called: the call activity's scope, its id, the pattern."""
 
 
 @dataclass
@@ -151,7 +152,11 @@ class ProcessReader:
     """Reads one `<process>` element into a `ProcessGraph`, reporting refusals to the reading."""
 
     def __init__(
-        self, reading: Reading, process: ET.Element, process_id: str, called: Callable[..., Any]
+        self,
+        reading: Reading,
+        process: ET.Element,
+        process_id: str,
+        called: Callable[[list[str]], Pattern | None],
     ) -> None:
         self.reading = reading
         self.element = process
@@ -300,21 +305,19 @@ class ProcessReader:
         what = describe(local, xml_id, name)
         contents: ET.Element | None = element
         inner_prefix = prefix
+        pattern: Pattern | None = None
         if local == "callActivity":
-            resolved = self._called(element, what)
-            if resolved is None:
+            callee = self._called(element, what)
+            if callee is None:
                 return None
-            if resolved is _AS_TASK:
-                contents = None
-            else:
-                contents = resolved  # type: ignore[assignment]
-                inner_prefix = f"{prefix}{self.reading.hrc_id(xml_id)}."
+            contents, pattern = callee.process, callee.pattern
+            inner_prefix = f"{prefix}{self.reading.hrc_id(xml_id)}."
         elif not any(
             bpmn_name(c) in FLOW_NODE_KINDS | {"subProcess", "callActivity"} for c in element
         ):
             contents = None
         hrc_id = prefix + self.reading.hrc_id(xml_id)
-        if contents is None:
+        if contents is None and pattern is None:
             # A collapsed activity with nothing in it is one task.
             node = self._node(local, xml_id, hrc_id, name, scope, self.reading.extra(element, what))
             node.keys.setdefault("bpmn", local)
@@ -331,12 +334,13 @@ class ProcessReader:
         finish = self._node("finish", xml_id, self.reading.fresh(f"{hrc_id}_ends"), name, scope)
         inner = self._scope(hrc_id, scope, begin, finish)
         self._loops(element, begin)
-        if local == "callActivity":
-            self.calling.append(contents.get("id", ""))
-            self._container(contents, inner, inner_prefix, outer or xml_id)
-            self.calling.pop()
-        else:
-            self._container(contents, inner, inner_prefix, outer or xml_id)
+        if pattern is not None:
+            self.graph.inlined.append((inner, hrc_id, pattern))
+            return begin, finish
+        assert contents is not None
+        self.calling.append(contents.get("id", ""))
+        self._container(contents, inner, inner_prefix, outer or xml_id)
+        self.calling.pop()
         return begin, finish
 
     def _scope(self, hrc_id: str, parent: Scope, begin: FlowNode, finish: FlowNode) -> Scope:
@@ -357,13 +361,15 @@ class ProcessReader:
         finish.cancels_places = inner.armed
         return inner
 
-    def _called(self, element: ET.Element, what: str) -> ET.Element | object | None:
-        """The process a call activity inlines, `_AS_TASK`, or None once refused."""
+    def _called(self, element: ET.Element, what: str) -> "_Callee | None":
+        """What a call activity calls; None once refused.
+
+        A process of the file, else a global task or nothing named (one task),
+        else the organisation's published pattern of that name.
+        """
         called = (element.get("calledElement") or "").strip()
-        if not called:
-            return _AS_TASK
-        if self.reading.global_task(called) is not None:
-            return _AS_TASK
+        if not called or self.reading.global_task(called) is not None:
+            return _Callee()
         process = self.reading.process_element(called)
         if process is not None:
             if called in self.calling:
@@ -373,16 +379,24 @@ class ProcessReader:
                     element.get("id", ""),
                 )
                 return None
-            return process
+            return _Callee(process=process)
         names = [called] + ([element.get("name", "")] if element.get("name") else [])
-        if self.called(names) is not None:
-            return _AS_TASK
-        self.reading.fail(
-            f"The {what} calls {called!r}, which is neither a process of this file nor a "
-            "published pattern of that name.",
-            element.get("id", ""),
-        )
-        return None
+        pattern = self.called(names)
+        if pattern is None:
+            self.reading.fail(
+                f"The {what} calls {called!r}, which is neither a process of this file nor a "
+                "published pattern of that name.",
+                element.get("id", ""),
+            )
+            return None
+        if len(pattern.processes) != 1:
+            self.reading.fail(
+                f"The {what} calls the published pattern {pattern.name!r}, which has "
+                f"{len(pattern.processes)} processes; a call activity inlines one.",
+                element.get("id", ""),
+            )
+            return None
+        return _Callee(pattern=pattern)
 
     # Boundary events.
 
@@ -908,8 +922,12 @@ class ProcessReader:
         return mapping
 
 
-_AS_TASK = object()
-"""A call activity imported as one task (a global task, a published pattern, or nothing named)."""
+@dataclass
+class _Callee:
+    """What a call activity calls: a process of the file, a published pattern, or neither (a task)."""
+
+    process: ET.Element | None = None
+    pattern: Pattern | None = None
 
 
 def _awaited(name: str) -> Json:

@@ -8,10 +8,11 @@ from typing import Any
 
 from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
 from hrc.engine.check import check_pattern
-from hrc.engine.document import FormatError
+from hrc.engine.document import FormatError, read_pattern
 from hrc.engine.model import Pattern
 from hrc.engine.runtime import CaseNet
-from tests.engine.test_bpmn import bpmn, flows, refused
+from tests.engine.builders import document, process
+from tests.engine.test_bpmn import _arcs, bpmn, flows, refused
 
 
 def _run(pattern: Pattern, data: dict[str, Any]) -> list[str]:
@@ -181,3 +182,161 @@ def test_elements_inside_a_sub_process_are_inspected_too() -> None:
         )
     )
     assert any("deep" in i.elements and '"Inner"' in i.message for i in error.issues)
+
+
+SPOT_TAPE = read_pattern(
+    document(
+        process("N", "p1 tc1 p2 to1 p3", performers={"tc1": "c1", "to1": "o1"}),
+        constraints=[("tc1", "to1", "time")],
+    )
+)
+
+
+def _calling(called_element: str) -> str:
+    return bpmn(
+        f'<startEvent id="s"/><callActivity id="tape" name="Tape" calledElement="{called_element}"/>'
+        '<endEvent id="e"/>' + flows("f1: s -> tape", "f2: tape -> e")
+    )
+
+
+def test_a_call_activity_inlines_the_published_pattern_it_names_with_its_actors() -> None:
+    asked: list[list[str]] = []
+
+    def published(names: list[str]) -> Pattern | None:
+        asked.append(names)
+        return SPOT_TAPE if "SpotTape" in names else None
+
+    pattern = bpmn_to_pattern(_calling("SpotTape"), published)
+    assert asked == [["SpotTape", "Tape"]]
+    assert _run(pattern, {}) == ["tape.tc1", "tape.to1"]
+    assert {(a.id, a.type) for a in pattern.actors} == {
+        ("tape.c1", "cobot"),
+        ("tape.o1", "operator"),
+    }
+    assert [(c.source, c.target) for c in pattern.constraints] == [("tape.tc1", "tape.to1")]
+
+
+def test_a_call_activity_nothing_resolves_is_refused_naming_what_it_calls() -> None:
+    error = refused(_calling("SpotTape"))
+    assert [i.message for i in error.issues] == [
+        "The call activity \"Tape\" (tape) calls 'SpotTape', which is neither a process of this "
+        "file nor a published pattern of that name."
+    ]
+
+
+def test_an_event_based_gateway_lets_the_first_event_take_the_branch() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><eventBasedGateway id="race"/>'
+        '<intermediateCatchEvent id="ok"><messageEventDefinition/></intermediateCatchEvent>'
+        '<intermediateCatchEvent id="late"><timerEventDefinition><timeDuration>PT1H'
+        "</timeDuration></timerEventDefinition></intermediateCatchEvent>"
+        '<task id="a"/><task id="b"/><endEvent id="e"/><endEvent id="e2"/>'
+        + flows("f1: s -> race", "f2: race -> ok", "f3: race -> late", "f4: ok -> a")
+        + flows("f5: late -> b", "f6: a -> e", "f7: b -> e2")
+    )
+    pattern = bpmn_to_pattern(text)
+    process = pattern.processes[0]
+    racing = {t for p, t in process.arcs if p == "f1"}
+    assert racing == {"ok", "late"}
+    assert _transition(pattern, "late").extra["timer"] == "PT1H"
+    assert _transition(pattern, "ok").extra["message"]["name"] == "ok"
+
+
+def test_an_error_end_inside_a_sub_process_leaves_through_the_boundary_that_catches_it() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><subProcess id="sub" name="Mount"><startEvent id="ss"/>'
+        '<task id="m"/><exclusiveGateway id="x"/><endEvent id="ok"/>'
+        '<endEvent id="fail"><errorEventDefinition errorRef="broken"/></endEvent>'
+        + flows("g1: ss -> m", "g2: m -> x", "g3: x -> ok", "g4: x -> fail")
+        + "</subProcess>"
+        '<boundaryEvent id="catch" attachedToRef="sub"><errorEventDefinition errorRef="broken"/>'
+        '</boundaryEvent><task id="scrap"/><task id="ship"/><endEvent id="e"/><endEvent id="e2"/>'
+        + flows("f1: s -> sub", "f2: sub -> ship", "f3: ship -> e", "f4: catch -> scrap")
+        + flows("f5: scrap -> e2"),
+        outside='<error id="broken" name="Part broken"/>',
+    )
+    pattern = bpmn_to_pattern(text)
+    thrown = next(t for p in pattern.processes for t in p.transitions if t.id.startswith("fail"))
+    arcs = _arcs(pattern)
+    assert (thrown.id, "f4") in arcs
+    assert ("sub_scope", thrown.id) in arcs
+    assert pattern.transition("catch") is None  # only the error end throws to it
+    assert "m" in thrown.extra["cancels"]
+
+
+def test_a_non_interrupting_boundary_event_fires_at_most_once_and_keeps_the_task() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><task id="a"/><endEvent id="e"/>'
+        '<boundaryEvent id="remind" attachedToRef="a" cancelActivity="false">'
+        "<timerEventDefinition><timeDuration>PT10M</timeDuration></timerEventDefinition>"
+        '</boundaryEvent><task id="call"/><endEvent id="e2"/>'
+        + flows("f1: s -> a", "f2: a -> e", "f3: remind -> call", "f4: call -> e2")
+    )
+    pattern = bpmn_to_pattern(text)
+    remind = _transition(pattern, "remind")
+    arcs = _arcs(pattern)
+    assert {("remind_armed", "remind"), ("a_scope", "remind"), ("remind", "a_scope")} <= arcs
+    assert "cancels" not in remind.extra
+    ends = next(t for p in pattern.processes for t in p.transitions if t.label == "a: ends")
+    assert ends.extra["cancels"] == ["remind_armed"]
+
+
+def test_multi_instance_with_a_literal_count_makes_copies_and_others_are_to_rewrite() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><task id="a" name="Screw"><multiInstanceLoopCharacteristics>'
+        "<loopCardinality>3</loopCardinality></multiInstanceLoopCharacteristics></task>"
+        '<task id="b"><multiInstanceLoopCharacteristics isSequential="true">'
+        "<loopCardinality>${n}</loopCardinality></multiInstanceLoopCharacteristics></task>"
+        '<endEvent id="e"/>' + flows("f1: s -> a", "f2: a -> b", "f3: b -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    assert _run(pattern, {}) == ["a", "a_2", "a_3", "b"]
+    assert _transition(pattern, "a_3").label == "Screw (3 of 3)"
+    assert "${n}" in _transition(pattern, "b").extra["rewrite"]
+
+
+def test_a_standard_loop_repeats_the_task_while_its_condition_holds() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><task id="a"><standardLoopCharacteristics>'
+        "<loopCondition>${tries &lt; 3}</loopCondition></standardLoopCharacteristics></task>"
+        '<endEvent id="e"/>' + flows("f1: s -> a", "f2: a -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    again = next(t for p in pattern.processes for t in p.transitions if t.id.startswith("a_again"))
+    assert again.extra == {"guard": "data.tries < 3"}
+    assert _run(pattern, {"tries": 5}) == ["a"]
+
+
+def test_a_link_event_jumps_to_the_catch_event_of_the_same_name() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><task id="a"/><intermediateThrowEvent id="go">'
+        '<linkEventDefinition name="L"/></intermediateThrowEvent>'
+        '<intermediateCatchEvent id="land"><linkEventDefinition name="L"/></intermediateCatchEvent>'
+        '<task id="b"/><endEvent id="e"/>'
+        + flows("f1: s -> a", "f2: a -> go", "f3: land -> b", "f4: b -> e")
+    )
+    assert _run(bpmn_to_pattern(text), {}) == ["a", "b"]
+
+
+def test_a_task_with_a_default_flow_chooses_between_its_flows() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><task id="a" default="other"/><task id="b"/><task id="c"/>'
+        '<exclusiveGateway id="m"/><endEvent id="e"/>'
+        '<sequenceFlow id="main" sourceRef="a" targetRef="b"><conditionExpression>'
+        "${ok}</conditionExpression></sequenceFlow>"
+        + flows("f1: s -> a", "other: a -> c", "f2: b -> m", "f3: c -> m", "f4: m -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    assert _run(pattern, {"ok": True}) == ["a", "b"]
+    assert _run(pattern, {"ok": False}) == ["a", "c"]
+
+
+def test_a_shared_event_definition_at_the_root_is_read_there() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><intermediateCatchEvent id="wait"><eventDefinitionRef>tick'
+        '</eventDefinitionRef></intermediateCatchEvent><endEvent id="e"/>'
+        + flows("f1: s -> wait", "f2: wait -> e"),
+        outside='<timerEventDefinition id="tick"><timeDuration>PT30S</timeDuration>'
+        "</timerEventDefinition>",
+    )
+    assert _transition(bpmn_to_pattern(text), "wait").extra["timer"] == "PT30S"
