@@ -11,11 +11,27 @@ of business process models in BPMN", Information and Software Technology 50
 | sequence flow f | place f (its name in the place's `name`) |
 | task T (task, userTask, manualTask, serviceTask, scriptTask, businessRuleTask, sendTask, receiveTask) | transition T performed by its lane's actor, labelled with its name (a kind other than `task` kept in its `bpmn` key); arcs from its incoming and to its outgoing flows' places. Several incoming flows merge first (the paper's normalisation: an exclusive merge, a silent transition per flow into a place `T_in`); several outgoing flows all get a token (a parallel split) |
 | none intermediate event E | silent transition E, with the same arcs as a task |
-| start event S | the net's source place: S itself when the process has one start event, each start event then fires through a silent transition into its outgoing flows. With several start events the source place is `<process>_start` and each start event is a silent transition S out of it (an instance starts at one of them) |
-| end event E | the net's sink place, in the same way: E when there is one, else `<process>_end`; every incoming flow reaches it through a silent transition |
+| start event S | a silent transition from the net's source place into its outgoing flows. The source place is S itself when the process has one start event (the step gets a fresh id), else `<process>_start` with each start event a transition S out of it (an instance starts at one of them). A process without start events starts at every node no flow enters (BPMN's implicit start) |
+| end event E | a silent transition per incoming flow into the net's sink place: E itself when there is one end event, else `<process>_end`. A node no flow leaves ends its path through an extra end (BPMN's implicit end) |
 | parallel gateway G (fork, join, or both) | one silent transition G consuming all incoming and producing all outgoing flows |
 | exclusive gateway G | a place where the choice or merge happens, with a silent transition per branch: a split keeps its incoming flow's place and gets a transition `G_<flow>` into each outgoing flow's place (the flow's condition becomes that transition's `guard`; the default flow's is "none of the others"); a merge gets a transition per incoming flow into the outgoing flow's place; a gateway with several of each gets its own place G between them |
-| lane | an actor (id: the lane's id), performing the tasks in it (the innermost lane when lanes nest); lanes without tasks are left out |
+| condition on a flow | a `guard` in hrc's language (`${a > 3}`, `#{ok && !late}`, `a gt 3` become `data.a > 3`, `data.ok and not data.late`, ... see `bpmn_conditions`); one that does not translate (prose, XPath, method calls) leaves the branch without guard and with a `rewrite` key saying what to rewrite, so the model stays a draft. An empty `<conditionExpression/>` is no condition. Conditions (or a default flow) on the flows out of a task or event: a silent exclusive choice after it |
+| event-based gateway G | a deferred choice: the events after G consume the same place, so the first to happen takes the branch |
+| inclusive gateway G | where G splits into at most 4 branches that meet again at one inclusive join (a block): a silent transition per non-empty subset of branches (guarded by its conditions), each also marking a place that tells the join which subset to wait for, and a join transition per subset. A split whose branches never meet again needs no join. A join no split of its block started, or a split with more branches, is refused |
+| sub-process S (and an inlined call activity) | flattened into the process between two silent steps, `S: begins` (id S) and `S: ends`: the first marks the contents' source place `S_start` and a scope place `S_scope`, the second takes the contents' sink place `S_done` and `S_scope`. Its ids keep theirs (a call activity's get `<call id>.` in front). A sub-process without contents is a task |
+| call activity C | its `calledElement` names a process of the file: that process is inlined as a sub-process (and not imported on its own; a call that reaches itself again is refused); a global task, or no called element: a task (the latter with `rewrite`); else `called` finds the organisation's published pattern of that name (the calledElement, then C's name): its net is inlined between C's steps, its actors and constraints with `<C>.` in front. Unresolved: refused, naming what it calls |
+| boundary event B on activity A | a silent transition consuming A's scope place (a task with boundary events gets a scope of its own: `A: begins` marks its input and the scope place, `A: ends` takes its output and the scope place). Interrupting: `cancels` every place and task inside A. Non-interrupting: an armed place marked by A's begin step lets B fire once per activation; B gives the scope place back, and A's end step `cancels` the armed place |
+| message event | catching (intermediate, boundary, or start fed by a message flow): `message` named after the BPMN message, awaited with `{"case": "case.id"}`; throwing (intermediate, end): `send`. Message flows between flow nodes of the file's processes: `send` on the sender (task or event), `message` on the receiver's transition, or on a silent step in front of a receiving task. Message flows to or from a pool without a process (a black box) are ignored |
+| signal event | as a message named `signal:<signal name>` |
+| timer event | `"timer": "<ISO duration>"` from its timeDuration; a timeDate, timeCycle or expression: `rewrite` |
+| conditional event | a `guard` from its condition, else `rewrite` |
+| link events | the throw event jumps to the catch event of the same name |
+| error and escalation end events | thrown to the nearest enclosing activity's boundary event that catches them: the end event's transition takes that activity's scope place, `cancels` its contents (interrupting) and marks the boundary event's outgoing flows. Uncaught, an error end `cancels` the whole process and ends it; an escalation ends its path. An error or escalation boundary event nothing inside throws to waits for a message `error:<name>` (or `escalation:<name>`) |
+| terminate end event | its transitions `cancels` every place and task of its scope (process or sub-process) |
+| start event with a trigger | a message start no message flow feeds, a timer, signal (no signal thrown in the file), conditional, error or escalation start: a none start; the kind stays in its `bpmn` key |
+| standard loop | after the task, a silent step back to its input (the loop condition as guard, else `rewrite`) and one onwards |
+| multi-instance task | loopCardinality a whole number up to 20: that many copies, side by side (parallel) or one after the other (sequential), ids `T`, `T_2`, ...; else one instance with `rewrite` |
+| lane | an actor (id: the lane's id), performing the tasks in it (the innermost lane when lanes nest); lanes without tasks are left out. A task inside a sub-process or called process is in its own lane, else its outermost activity's, else its pool's |
 | pool without lanes | one actor: the participant, or `<process>_actor` |
 | process | a process of the pattern (several pools: several processes, as in Coexistence); its workpiece is its `hrc:workpiece` attribute, else the name of its pool, else its own name or id (wpassign is total) |
 
@@ -29,14 +45,15 @@ holds, as a JSON object, the keys of its `hrc-pattern/1` object the BPMN part
 does not carry (task configuration, an id XML cannot hold, ...), and overrides
 it on import: that is how our own exports come back with everything.
 
-What the mapping does not cover is refused with a FormatError that names the
-element: inclusive, complex and event-based gateways, subprocesses and call
-activities, boundary events, events with a definition (timer, message, ...),
-loop and multi-instance tasks, message flows, choreographies and
-conversations, and conditions on flows out of anything but an exclusive
-gateway. Nothing else is read from the file, so a refused import creates
-nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the pattern in
-its actors' lanes.
+What the mapping does not cover is refused with a FormatError whose messages
+name each element once, by kind, name and id (`task "Check order" (sid-89...)`),
+at every level of the file, and say nothing of the flows that touch a refused
+element: complex gateways, ad-hoc sub-processes, transactions, compensation
+(compensation events, boundary events and handlers), event sub-processes,
+unresolved call activities, inclusive gateways outside a block, choreographies
+and conversations. Nothing else is read from the file, so a refused import
+creates nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the
+pattern in its actors' lanes.
 
 Exclusive gateways choose when they are reached (BPMN's data-based choice),
 not when a task starts: a round trip through `pattern_to_bpmn` keeps the tasks,
