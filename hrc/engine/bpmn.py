@@ -452,6 +452,8 @@ class _Importer:
             if not found:
                 what = describe("process", root.hrc_id, None)
                 self.fail(f"The {what} has no flow nodes to {kind} at.", root.hrc_id)
+        if root.place is not None:
+            net.place(root.place, root)
         for scope in graph.scopes.values():
             if scope is root:
                 continue

@@ -46,6 +46,7 @@ KIND_WORDS = {
     "eventBasedGateway": "event-based gateway",
     "complexGateway": "complex gateway",
     "subProcess": "sub-process",
+    "eventSubProcess": "event sub-process",
     "adHocSubProcess": "ad-hoc sub-process",
     "callActivity": "call activity",
     "userTask": "user task",
@@ -123,6 +124,8 @@ class FlowNode:
     post_flows: list["Flow"] = field(default_factory=list)
     """Flows its transition marks besides its own: an error thrown to a boundary event's."""
     routed: bool = False
+    to_sink: "Scope | None" = None
+    """A scope (the process) whose sink its transition marks, not its own scope's."""
     """An end event whose token goes to a boundary event's flows, not to its scope's end."""
     keys: Json = field(default_factory=dict)
     """The hrc-pattern keys the reader derived for its transition (`message`, `timer`, ...)."""
@@ -245,6 +248,8 @@ class FlowNet:
             self.arc(step_id, place)
         for flow in node.post_flows:
             self.arc(step_id, flow.place)
+        if node.to_sink is not None:
+            self.arc(step_id, node.to_sink.sink)
         if node.cancels or node.cancels_places:
             self.cancelling.append((self.transitions[-1], node))
         return step_id
@@ -488,7 +493,7 @@ class FlowNet:
                     step_id, label = self.fresh(f"{event.hrc_id}_{flow.xml_id}"), None
                 step = self._step(event, step_id, label=label, extra=extra)
                 self.arc(flow.place, step)
-                if not event.post and not event.routed:
+                if not event.post and not event.routed and event.to_sink is None:
                     self.arc(step, scope.sink)
 
 

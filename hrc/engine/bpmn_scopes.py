@@ -178,7 +178,14 @@ class ProcessReader:
         """id() of a scope's begin step -> the scope, for boundary events attached to it."""
 
     def read(self) -> ProcessGraph:
-        self._container(self.element, self.graph.root, "", None)
+        root = self.graph.root
+        self._container(self.element, root, "", None)
+        if root.place is not None:
+            # The process' own scope, for its event sub-processes: from its start to its end.
+            for start in self.graph.starts.get(root.hrc_id, []):
+                start.post.append(root.place)
+            for end in self.graph.ends.get(root.hrc_id, []):
+                end.cancels_places.append(root.place)
         self._route_throws()
         self._links()
         self._inclusive_blocks()
@@ -254,9 +261,10 @@ class ProcessReader:
         name = (element.get("name") or "").strip() or None
         what = describe(local, xml_id, name)
         if element.get("isForCompensation") == "true":
+            undone = self._compensated(xml_id)
             self.reading.fail(
-                f"The {what} compensates another activity: compensation is not imported; "
-                "draw the undoing steps as ordinary tasks on an error path.",
+                f"The {what} compensates {undone or 'another activity'}: compensation is not "
+                "imported; draw the undoing steps as ordinary tasks on an error path.",
                 xml_id,
             )
             return None
@@ -264,11 +272,7 @@ class ProcessReader:
             self.reading.fail(f"The {what} cannot be imported: {REFUSED_WHY[local]}.", xml_id)
             return None
         if local == "subProcess" and element.get("triggeredByEvent") == "true":
-            self.reading.fail(
-                f"The event {what} cannot be imported: draw what it does as a boundary event "
-                "on the activity it interrupts.",
-                xml_id,
-            )
+            self._event_sub_process(element, scope, prefix, outer)
             return None
         if local in ("subProcess", "callActivity"):
             return self._activity_scope(element, local, scope, prefix, outer)
@@ -343,6 +347,83 @@ class ProcessReader:
         self.calling.pop()
         return begin, finish
 
+    def _event_sub_process(
+        self, element: ET.Element, host: Scope, prefix: str, outer: str | None
+    ) -> None:
+        """An interrupting event sub-process: a boundary event on the scope that holds it.
+
+        Its start event's trigger takes the host's scope place and cancels its
+        contents; the sub-process' contents then run, and its end continues where
+        the host's would (the process' end, at top level).
+        """
+        xml_id = element.get("id", "")
+        name = (element.get("name") or "").strip() or None
+        what = describe("eventSubProcess", xml_id, name)
+        starts = children(element, "startEvent")
+        why = None
+        if len(starts) != 1:
+            why = f"it has {len(starts)} start events; hrc imports one, as its trigger"
+        elif starts[0].get("isInterrupting", "true") == "false":
+            why = (
+                "it does not interrupt; hrc imports interrupting event sub-processes: draw "
+                "this one as a non-interrupting boundary event on the activity it runs beside"
+            )
+        if why is not None:
+            self.reading.fail(f"The {what} cannot be imported: {why}.", xml_id)
+            self.refused.add(xml_id)
+            return
+        start = starts[0]
+        kind = self._trigger(start, self._node("startEvent", "", "", None, host))
+        self.graph.nodes.pop()  # the probe above only read the trigger
+        if kind is None:
+            self.reading.fail(
+                f"The {what} cannot be imported: its start event has no trigger (message, "
+                "timer, error, signal, ...), so nothing would ever start it.",
+                xml_id,
+            )
+            self.refused.add(xml_id)
+            return
+        if kind.kind in ("compensate", "cancel", "reference"):
+            self.reading.fail(
+                f"The {what} starts on a {kind.kind} event: compensation and cancellation are "
+                "not imported.",
+                xml_id,
+            )
+            self.refused.add(xml_id)
+            return
+        if host.place is None:
+            host.place = self.reading.fresh(f"{host.hrc_id}_running")
+        trigger_id = prefix + self.reading.hrc_id(start.get("id", ""))
+        catch = self._node(
+            "boundaryEvent",
+            start.get("id", ""),
+            self.reading.fresh(f"{trigger_id}_trigger"),
+            (start.get("name") or "").strip() or name,
+            host.parent or host,
+            self.reading.extra(element, what),
+        )
+        trigger = self._trigger(start, catch)
+        catch.pre.append(host.place)
+        catch.cancels.append(host)
+        boundary = _Boundary(catch, trigger, True, host)
+        self.boundaries.append(boundary)
+        self.boundary_of_scope.setdefault(host.hrc_id, []).append(boundary)
+        self._event_keys(catch, trigger, catching=True, what=what)
+        hrc_id = prefix + self.reading.hrc_id(xml_id)
+        begin = self._node("begin", xml_id, hrc_id, name, host)
+        finish = self._node("finish", xml_id, self.reading.fresh(f"{hrc_id}_ends"), name, host)
+        inner = self._scope(hrc_id, host, begin, finish)
+        self.synthetic_flow(catch, begin, host)
+        self._container(element, inner, prefix, outer or xml_id)
+        for inner_start in self.graph.starts.get(inner.hrc_id, []):
+            # The trigger is the boundary event's: inside, the start is a plain one.
+            for key in ("message", "timer", "guard", "rewrite"):
+                inner_start.keys.pop(key, None)
+        if host.parent is None:
+            finish.to_sink = host
+        else:
+            finish.post_flows = self._finishes[host.hrc_id].outgoing
+
     def _scope(self, hrc_id: str, parent: Scope, begin: FlowNode, finish: FlowNode) -> Scope:
         """A scope between two steps: begin marks its source and scope places, finish takes them."""
         fresh = self.reading.fresh
@@ -397,6 +478,21 @@ class ProcessReader:
             )
             return None
         return _Callee(pattern=pattern)
+
+    def _compensated(self, handler_id: str) -> str | None:
+        """The activity a compensation handler undoes, through its boundary event's association."""
+        elements = {e.get("id"): e for e in self.element.iter() if e.get("id")}
+        for association in self.element.iter():
+            if bpmn_name(association) != "association":
+                continue
+            if association.get("targetRef") != handler_id:
+                continue
+            boundary = elements.get(association.get("sourceRef"))
+            activity = elements.get(boundary.get("attachedToRef")) if boundary is not None else None
+            if activity is not None:
+                kind = bpmn_name(activity) or "activity"
+                return describe(kind, activity.get("id", ""), activity.get("name"))
+        return None
 
     # Boundary events.
 
@@ -607,7 +703,7 @@ class ProcessReader:
             n
             for n in nodes
             if not n.outgoing
-            and n.kind not in ("startEvent", "endEvent")
+            and n.kind != "endEvent"
             and not n.post
             and not (n.kind == "intermediateThrowEvent" and n.keys.get("bpmn") == "link")
         ]
@@ -726,10 +822,10 @@ class ProcessReader:
                     f"The condition {text[:200]!r} of the {what} did not translate into hrc's "
                     "expressions: write it as a guard over data."
                 )
-        elif kind in ("error", "escalation") and catching:
-            keys["bpmn"] = f"{kind} start"
         elif kind in ("error", "escalation") and node.kind == "boundaryEvent":
             keys["message"] = _awaited(f"{kind}:{trigger.name or node.name or node.xml_id}")
+        elif kind in ("error", "escalation") and catching:
+            keys["bpmn"] = f"{kind} start"
         sent_extra = self.reading.messages_out(node.xml_id)
         if not catching and "send" not in keys and sent_extra:
             keys["send"] = _sent(sent_extra[0])
@@ -820,7 +916,7 @@ class ProcessReader:
                     # An uncaught error ends the whole process, like a terminate end event.
                     thrower.cancels.append(self.graph.root)
                     if thrower.scope is not self.graph.root:
-                        thrower.post.append(self.graph.root.sink)
+                        thrower.to_sink = self.graph.root
                 continue
             boundary.caught = True
             if boundary.interrupting and thrower.kind == "endEvent":

@@ -35,6 +35,10 @@ def _transition(pattern: Pattern, transition_id: str) -> Any:
     return found
 
 
+SIMPLE_FLOW = '<startEvent id="s"/><task id="a"/><endEvent id="e"/>' + flows(
+    "f1: s -> a", "f2: a -> e"
+)
+
 SUB = bpmn(
     '<startEvent id="s"/><task id="a" name="Prepare"/>'
     '<subProcess id="sub" name="Assemble"><startEvent id="ss"/><task id="b" name="Screw"/>'
@@ -340,3 +344,52 @@ def test_a_shared_event_definition_at_the_root_is_read_there() -> None:
         "</timerEventDefinition>",
     )
     assert _transition(bpmn_to_pattern(text), "wait").extra["timer"] == "PT30S"
+
+
+def test_an_interrupting_event_sub_process_is_a_boundary_event_on_its_process() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><task id="a"/><endEvent id="e"/>'
+        + flows("f1: s -> a", "f2: a -> e")
+        + '<subProcess id="stop" name="Emergency stop" triggeredByEvent="true">'
+        '<startEvent id="alarm" name="Alarm"><messageEventDefinition/></startEvent>'
+        '<task id="secure"/><endEvent id="se"/>'
+        + flows("g1: alarm -> secure", "g2: secure -> se")
+        + "</subProcess>"
+    )
+    pattern = bpmn_to_pattern(text)
+    trigger = next(t for p in pattern.processes for t in p.transitions if t.label == "Alarm")
+    assert trigger.extra["message"]["name"] == "Alarm"
+    assert "a" in trigger.extra["cancels"]
+    assert ("P_running", trigger.id) in _arcs(pattern)
+    ending = _transition(pattern, "e_end")
+    assert ending.extra["cancels"] == ["P_running"]  # the process' end closes the window
+
+
+def test_a_non_interrupting_event_sub_process_is_refused_saying_why() -> None:
+    error = refused(
+        bpmn(
+            SIMPLE_FLOW + '<subProcess id="esp" name="Log" triggeredByEvent="true">'
+            '<startEvent id="t" isInterrupting="false"><messageEventDefinition/></startEvent>'
+            "</subProcess>"
+        )
+    )
+    assert [i.elements for i in error.issues] == [("esp",)]
+    assert 'event sub-process "Log" (esp)' in error.issues[0].message
+    assert "does not interrupt" in error.issues[0].message
+
+
+def test_a_compensation_handler_is_refused_naming_the_activity_it_undoes() -> None:
+    error = refused(
+        bpmn(
+            '<startEvent id="s"/><task id="book" name="Book hotel"/><endEvent id="e"/>'
+            + flows("f1: s -> book", "f2: book -> e")
+            + '<boundaryEvent id="comp" attachedToRef="book"><compensateEventDefinition/>'
+            '</boundaryEvent><task id="cancel" name="Cancel hotel" isForCompensation="true"/>'
+            '<association id="as" sourceRef="comp" targetRef="cancel"/>'
+        )
+    )
+    messages = [i.message for i in error.issues]
+    assert any(
+        m.startswith('The task "Cancel hotel" (cancel) compensates task "Book hotel" (book)')
+        for m in messages
+    ), messages
