@@ -364,7 +364,8 @@ class _Importer:
             (flow.get("name") or "").strip() or None,
             flow.get("id", ""),
         ]
-        name = next(n for n in named if n is not None)
+        # Every flow into one receiver carries the name it awaits.
+        name = self.received.get(target) or next(n for n in named if n is not None)
         self.sent.setdefault(source, []).append(name)
         self.received.setdefault(target, name)
 
@@ -556,14 +557,20 @@ class _Importer:
         lane is the pool's.
         """
         lane_of: dict[str, ET.Element] = {}
-        lanes = list(self._all_lanes(process))
+        # A called process' own lanes count for the tasks inlined from it.
+        lanes = list(self._all_lanes(process)) + [
+            lane
+            for other in self.processes.values()
+            if other is not process
+            for lane in self._all_lanes(other)
+        ]
         for lane in lanes:  # outer lanes first, so an inner lane overrides
             for reference in _children(lane, "flowNodeRef"):
                 lane_of[(reference.text or "").strip()] = lane
         performers: dict[str, str] = {}
         default: str | None = None
-        for task_id, lookup in graph.tasks.items():
-            home = lane_of.get(lookup)
+        for task_id, lookups in graph.tasks.items():
+            home = next((lane_of[i] for i in lookups if i in lane_of), None)
             if home is not None:
                 performers[task_id] = self._actor(home, f"lane {home.get('id')}")
             elif pool is not None:

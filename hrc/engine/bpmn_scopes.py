@@ -132,8 +132,8 @@ class ProcessGraph:
     """Scope id -> its start events."""
     ends: dict[str, list[FlowNode]] = field(default_factory=dict)
     scopes: dict[str, Scope] = field(default_factory=dict)
-    tasks: dict[str, str] = field(default_factory=dict)
-    """hrc id of each task -> the XML id its lane is looked up by."""
+    tasks: dict[str, list[str]] = field(default_factory=dict)
+    """hrc id of each task -> the XML ids its lane is looked up by: its own, its outermost activity's."""
     inlined: list[tuple[Scope, str, Pattern]] = field(default_factory=list)
     """Published patterns called: the call activity's scope, its id, the pattern."""
 
@@ -289,7 +289,7 @@ class ProcessReader:
         )
         node.default = element.get("default")
         if local in TASK_KINDS:
-            self.graph.tasks[node.hrc_id] = outer or xml_id
+            self.graph.tasks[node.hrc_id] = [xml_id] + ([outer] if outer else [])
             self._task_messages(node)
             self._loops(element, node)
         elif local in EVENT_KINDS and not self._event(element, node):
@@ -325,7 +325,7 @@ class ProcessReader:
             # A collapsed activity with nothing in it is one task.
             node = self._node(local, xml_id, hrc_id, name, scope, self.reading.extra(element, what))
             node.keys.setdefault("bpmn", local)
-            self.graph.tasks[hrc_id] = outer or xml_id
+            self.graph.tasks[hrc_id] = [xml_id] + ([outer] if outer else [])
             if local == "callActivity" and not element.get("calledElement"):
                 node.keys["rewrite"] = (
                     f"The {what} names no called element: imported as one task; draw "

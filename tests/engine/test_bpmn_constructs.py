@@ -393,3 +393,37 @@ def test_a_compensation_handler_is_refused_naming_the_activity_it_undoes() -> No
         m.startswith('The task "Cancel hotel" (cancel) compensates task "Book hotel" (book)')
         for m in messages
     ), messages
+
+
+def test_tasks_inlined_from_a_called_process_keep_the_lanes_they_have_there() -> None:
+    text = f"""<definitions xmlns="{BPMN_NAMESPACE}" id="d" targetNamespace="urn:t">
+      <process id="Main"><laneSet id="ls1"><lane id="op" name="Operator">
+        <flowNodeRef>call</flowNodeRef></lane></laneSet>
+        <startEvent id="s"/><callActivity id="call" calledElement="Sub"/><endEvent id="e"/>
+        {flows("f1: s -> call", "f2: call -> e")}</process>
+      <process id="Sub"><laneSet id="ls2"><lane id="robot" name="Cobot">
+        <flowNodeRef>weld</flowNodeRef></lane></laneSet>
+        <startEvent id="s2"/><task id="weld"/><task id="check"/><endEvent id="e2"/>
+        {flows("g1: s2 -> weld", "g2: weld -> check", "g3: check -> e2")}</process>
+    </definitions>"""
+    pattern = bpmn_to_pattern(text)
+    assert _transition(pattern, "call.weld").performer == "robot"
+    assert _transition(pattern, "call.check").performer == "op"
+
+
+def test_every_message_flow_into_one_receiver_carries_the_name_it_awaits() -> None:
+    text = f"""<definitions xmlns="{BPMN_NAMESPACE}" id="d" targetNamespace="urn:t">
+      <collaboration id="c"><participant id="p1" processRef="A"/>
+        <participant id="p2" processRef="B"/>
+        <messageFlow id="m1" name="ready" sourceRef="a1" targetRef="wait"/>
+        <messageFlow id="m2" name="also ready" sourceRef="a2" targetRef="wait"/></collaboration>
+      <process id="A"><startEvent id="s"/><task id="a1"/><task id="a2"/><endEvent id="e"/>
+        {flows("f1: s -> a1", "f2: a1 -> a2", "f3: a2 -> e")}</process>
+      <process id="B"><startEvent id="s2"/><intermediateCatchEvent id="wait">
+        <messageEventDefinition/></intermediateCatchEvent><endEvent id="e2"/>
+        {flows("g1: s2 -> wait", "g2: wait -> e2")}</process>
+    </definitions>"""
+    pattern = bpmn_to_pattern(text)
+    awaited = _transition(pattern, "wait").extra["message"]["name"]
+    assert awaited == "ready"
+    assert {_transition(pattern, t).extra["send"]["name"] for t in ("a1", "a2")} == {awaited}
