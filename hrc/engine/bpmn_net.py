@@ -124,6 +124,8 @@ class FlowNode:
     post_flows: list["Flow"] = field(default_factory=list)
     """Flows its transition marks besides its own: an error thrown to a boundary event's."""
     routed: bool = False
+    loop_head: "FlowNode | None" = None
+    """A looping scope's begin step, on its end step: the loop goes back there."""
     to_sink: "Scope | None" = None
     """A scope (the process) whose sink its transition marks, not its own scope's."""
     """An end event whose token goes to a boundary event's flows, not to its scope's end."""
@@ -176,6 +178,8 @@ class FlowNet:
         self.transitions: list[Json] = []
         self.arcs: list[list[str]] = []
         self.cancelling: list[tuple[Json, FlowNode]] = []
+        self.loop_inputs: dict[int, str] = {}
+        """id() of a looping scope's begin step -> the place its loop comes back to."""
 
     def transition(
         self,
@@ -307,7 +311,13 @@ class FlowNet:
             if into is not None:
                 self.arc(into, after)
         if node.loop is not None and into is not None:
-            after = self._loop(node, into, after)
+            if node.kind == "begin":
+                self.loop_inputs[id(node)] = into
+            else:
+                after = self._loop(node, into, after)
+        head = node.loop_head
+        if head is not None and id(head) in self.loop_inputs:
+            after = self._loop(head, self.loop_inputs[id(head)], after)
         # Several flows out of an activity all get a token: a parallel split, no step needed.
         for flow in node.outgoing:
             self.arc(after, flow.place)

@@ -338,6 +338,8 @@ class ProcessReader:
         finish = self._node("finish", xml_id, self.reading.fresh(f"{hrc_id}_ends"), name, scope)
         inner = self._scope(hrc_id, scope, begin, finish)
         self._loops(element, begin)
+        if begin.loop is not None:
+            finish.loop_head = begin  # the step back goes from its end to its beginning
         if pattern is not None:
             self.graph.inlined.append((inner, hrc_id, pattern))
             return begin, finish
@@ -871,11 +873,7 @@ class ProcessReader:
                 if text
                 else None
             )
-            if node.kind == "begin":
-                node.keys["rewrite"] = (
-                    f"The {what} loops: a looping sub-process is imported once; draw the loop with an exclusive gateway."
-                )
-            elif guard is not None:
+            if guard is not None:
                 node.loop = {"guard": guard}
             else:
                 node.loop = {
@@ -895,11 +893,13 @@ class ProcessReader:
         if cardinality.isdigit() and 1 <= int(cardinality) <= MAX_COPIES and node.kind != "begin":
             node.copies = (int(cardinality), sequential)
             return
-        how = (
-            f"{cardinality[:200]!r} times"
-            if cardinality
-            else "a number of times known only at run time"
-        )
+        collection = next((v for k, v in multiple.attrib.items() if k.endswith("collection")), None)
+        if cardinality:
+            how = f"{cardinality[:200]!r} times"
+        elif collection:
+            how = f"once per item of {collection[:200]!r}"
+        else:
+            how = "a number of times known only at run time"
         node.keys["rewrite"] = (
             f"The {what} runs {how} ({'in sequence' if sequential else 'in parallel'}): it is "
             "imported once; draw its copies."
@@ -971,6 +971,13 @@ class ProcessReader:
         for split in [
             n for n in self.graph.nodes if n.kind == "inclusiveGateway" and len(n.outgoing) > 1
         ]:
+            if len(split.incoming) > 1:
+                self.reading.fail(
+                    f"The {split.describe()} both joins and splits: draw an inclusive join and "
+                    "a separate inclusive split.",
+                    split.xml_id,
+                )
+                continue
             if len(split.outgoing) > MAX_INCLUSIVE_BRANCHES:
                 self.reading.fail(
                     f"The {split.describe()} has {len(split.outgoing)} branches; inclusive "

@@ -427,3 +427,19 @@ def test_every_message_flow_into_one_receiver_carries_the_name_it_awaits() -> No
     awaited = _transition(pattern, "wait").extra["message"]["name"]
     assert awaited == "ready"
     assert {_transition(pattern, t).extra["send"]["name"] for t in ("a1", "a2")} == {awaited}
+
+
+def test_a_looping_sub_process_goes_back_from_its_end_to_its_beginning() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><subProcess id="sub" name="Polish"><standardLoopCharacteristics>'
+        "<loopCondition>${rough}</loopCondition></standardLoopCharacteristics>"
+        '<startEvent id="ss"/><task id="p"/><endEvent id="se"/>'
+        + flows("g1: ss -> p", "g2: p -> se")
+        + '</subProcess><endEvent id="e"/>'
+        + flows("f1: s -> sub", "f2: sub -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    again = next(t for p in pattern.processes for t in p.transitions if t.label == "Polish: again")
+    assert again.extra == {"guard": "data.rough"}
+    assert _run(pattern, {"rough": False}) == ["p"]
+    assert check_pattern(pattern).sound is True
