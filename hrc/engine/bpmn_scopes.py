@@ -8,17 +8,24 @@ Events become the keys of their transitions (`message`, `send`, `timer`,
 `bpmn_net.FlowNet` builds the net.
 """
 
-import re
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 from hrc.engine.bpmn_conditions import translate
+from hrc.engine.bpmn_events import (
+    Reading,
+    Trigger,
+    event_keys,
+    task_messages,
+    trigger_of,
+)
+from hrc.engine.bpmn_gateways import deferred_choices, inclusive_blocks
+from hrc.engine.bpmn_loops import mark_loops
 from hrc.engine.bpmn_net import (
     EVENT_KINDS,
     GATEWAY_KINDS,
-    MAX_INCLUSIVE_BRANCHES,
     TASK_KINDS,
     Flow,
     FlowNode,
@@ -77,48 +84,6 @@ REFUSED_WHY = {
     "adHocSubProcess": "its tasks run in any order and number, which hrc's nets do not model",
     "transaction": "transactions (cancel and compensation) are not imported",
 }
-CORRELATION_SEND = {"case": "=case.id"}
-CORRELATION_AWAIT = {"case": "case.id"}
-MAX_COPIES = 20
-"""Multi-instance copies made at import; a larger cardinality is imported once, to rewrite."""
-DURATION = re.compile(
-    r"^P(?!$)(\d+(\.\d+)?D)?(T(?=\d)(\d+(\.\d+)?H)?(\d+(\.\d+)?M)?(\d+(\.\d+)?S)?)?$"
-)
-
-
-class Reading(Protocol):
-    """What the file's reader gives the process reader."""
-
-    def fail(self, message: str, *elements: str) -> None: ...
-
-    def fresh(self, base: str) -> str: ...
-
-    def hrc_id(self, xml_id: str) -> str: ...
-
-    def extra(self, element: ET.Element, where: str) -> Json: ...
-
-    def process_element(self, xml_id: str) -> ET.Element | None: ...
-
-    def global_task(self, xml_id: str) -> ET.Element | None: ...
-
-    def definition_name(self, reference: str | None) -> str | None: ...
-
-    def message_in(self, xml_id: str) -> str | None: ...
-
-    def messages_out(self, xml_id: str) -> list[str]: ...
-
-    def signal_thrown(self, name: str) -> bool: ...
-
-    def event_definition(self, xml_id: str) -> ET.Element | None: ...
-
-
-@dataclass
-class Trigger:
-    """An event's definition: its kind (`message`, `timer`, ...) and what it names."""
-
-    kind: str
-    element: ET.Element
-    name: str | None = None
 
 
 @dataclass
@@ -188,19 +153,9 @@ class ProcessReader:
                 end.cancels_places.append(root.place)
         self._route_throws()
         self._links()
-        self._inclusive_blocks()
-        self._deferred_choices()
+        inclusive_blocks(self.graph.nodes, self.reading.fail)
+        deferred_choices(self.graph.nodes)
         return self.graph
-
-    def _deferred_choices(self) -> None:
-        """An event-based gateway's outgoing flows share one place: its events race for it."""
-        for gateway in self.graph.nodes:
-            if gateway.kind != "eventBasedGateway":
-                continue
-            single = len(gateway.incoming) == 1
-            centre = gateway.incoming[0].place if single else gateway.hrc_id
-            for flow in gateway.outgoing:
-                flow.place = centre
 
     # Containers: the process, sub-processes, called processes.
 
@@ -290,8 +245,8 @@ class ProcessReader:
         node.default = element.get("default")
         if local in TASK_KINDS:
             self.graph.tasks[node.hrc_id] = [xml_id] + ([outer] if outer else [])
-            self._task_messages(node)
-            self._loops(element, node)
+            task_messages(self.reading, node)
+            mark_loops(element, node)
         elif local in EVENT_KINDS and not self._event(element, node):
             self.refused.add(xml_id)
             return None
@@ -331,13 +286,13 @@ class ProcessReader:
                     f"The {what} names no called element: imported as one task; draw "
                     "the tasks it calls in its place."
                 )
-            self._task_messages(node)
-            self._loops(element, node)
+            task_messages(self.reading, node)
+            mark_loops(element, node)
             return node, node
         begin = self._node("begin", xml_id, hrc_id, name, scope, self.reading.extra(element, what))
         finish = self._node("finish", xml_id, self.reading.fresh(f"{hrc_id}_ends"), name, scope)
         inner = self._scope(hrc_id, scope, begin, finish)
-        self._loops(element, begin)
+        mark_loops(element, begin)
         if begin.loop is not None:
             finish.loop_head = begin  # the step back goes from its end to its beginning
         if pattern is not None:
@@ -375,7 +330,7 @@ class ProcessReader:
             self.refused.add(xml_id)
             return
         start = starts[0]
-        kind = self._trigger(start, self._node("startEvent", "", "", None, host))
+        kind = trigger_of(self.reading, start, self._node("startEvent", "", "", None, host))
         self.graph.nodes.pop()  # the probe above only read the trigger
         if kind is None:
             self.reading.fail(
@@ -404,13 +359,13 @@ class ProcessReader:
             host.parent or host,
             self.reading.extra(element, what),
         )
-        trigger = self._trigger(start, catch)
+        trigger = trigger_of(self.reading, start, catch)
         catch.pre.append(host.place)
         catch.cancels.append(host)
         boundary = _Boundary(catch, trigger, True, host)
         self.boundaries.append(boundary)
         self.boundary_of_scope.setdefault(host.hrc_id, []).append(boundary)
-        self._event_keys(catch, trigger, catching=True, what=what)
+        event_keys(self.reading, catch, trigger, catching=True, what=what)
         hrc_id = prefix + self.reading.hrc_id(xml_id)
         begin = self._node("begin", xml_id, hrc_id, name, host)
         finish = self._node("finish", xml_id, self.reading.fresh(f"{hrc_id}_ends"), name, host)
@@ -525,7 +480,7 @@ class ProcessReader:
             scope,
             self.reading.extra(element, what),
         )
-        trigger = self._trigger(element, node)
+        trigger = trigger_of(self.reading, element, node)
         if trigger is not None and trigger.kind in ("compensate", "cancel"):
             self.reading.fail(
                 f"The {what} starts a {trigger.kind} handler: compensation and cancellation "
@@ -554,7 +509,7 @@ class ProcessReader:
         boundary = _Boundary(node, trigger, interrupting, inner)
         self.boundaries.append(boundary)
         self.boundary_of_scope.setdefault(inner.hrc_id, []).append(boundary)
-        self._event_keys(node, trigger, catching=True, what=what)
+        event_keys(self.reading, node, trigger, catching=True, what=what)
         return node
 
     def _task_scope(self, task: FlowNode) -> Scope:
@@ -723,33 +678,9 @@ class ProcessReader:
 
     # Events.
 
-    def _trigger(self, element: ET.Element, node: FlowNode) -> Trigger | None:
-        for given in element:
-            child = given
-            if bpmn_name(given) == "eventDefinitionRef":
-                # A definition at the file's root, shared by several events.
-                shared = self.reading.event_definition(text_of(given))
-                if shared is None:
-                    return Trigger("reference", given, text_of(given))
-                child = shared
-            local = bpmn_name(child) or ""
-            if local.endswith("EventDefinition"):
-                kind = local.removesuffix("EventDefinition")
-                reference = (
-                    child.get("messageRef")
-                    or child.get("signalRef")
-                    or child.get("errorRef")
-                    or child.get("escalationRef")
-                )
-                name = self.reading.definition_name(reference)
-                if kind == "link":
-                    name = child.get("name") or node.name
-                return Trigger(kind, child, name)
-        return None
-
     def _event(self, element: ET.Element, node: FlowNode) -> bool:
         """Sets the keys an event's trigger gives its transition; False once refused."""
-        trigger = self._trigger(element, node)
+        trigger = trigger_of(self.reading, element, node)
         what = node.describe()
         if trigger is None:
             return True
@@ -781,129 +712,8 @@ class ProcessReader:
             "escalation",
         ):
             self.throwers.append((node, trigger))
-        self._event_keys(node, trigger, catching=catching, what=what)
+        event_keys(self.reading, node, trigger, catching=catching, what=what)
         return True
-
-    def _event_keys(
-        self, node: FlowNode, trigger: Trigger | None, *, catching: bool, what: str
-    ) -> None:
-        if trigger is None:
-            return
-        kind = trigger.kind
-        keys: Json = {}
-        if kind == "message":
-            if catching:
-                name = self.reading.message_in(node.xml_id)
-                if node.kind == "startEvent" and name is None:
-                    keys["bpmn"] = "message start"
-                else:
-                    keys["message"] = _awaited(name or trigger.name or node.name or node.xml_id)
-            else:
-                sent = self.reading.messages_out(node.xml_id)
-                keys["send"] = _sent(sent[0] if sent else trigger.name or node.name or node.xml_id)
-        elif kind == "signal":
-            name = f"signal:{trigger.name or node.name or node.xml_id}"
-            if not catching:
-                keys["send"] = _sent(name)
-            elif node.kind == "startEvent" and not self.reading.signal_thrown(name):
-                keys["bpmn"] = "signal start"
-            else:
-                keys["message"] = _awaited(name)
-        elif kind == "timer":
-            keys.update(self._timer(trigger.element, node, what))
-        elif kind == "conditional":
-            condition = next(iter(children(trigger.element, "condition")), None)
-            text = text_of(condition)
-            guard = translate(text, condition.get("language") if condition is not None else None)
-            if node.kind == "startEvent":
-                keys["bpmn"] = "conditional start"
-            elif guard is not None:
-                keys["guard"] = guard
-            else:
-                keys["rewrite"] = (
-                    f"The condition {text[:200]!r} of the {what} did not translate into hrc's "
-                    "expressions: write it as a guard over data."
-                )
-        elif kind in ("error", "escalation") and node.kind == "boundaryEvent":
-            keys["message"] = _awaited(f"{kind}:{trigger.name or node.name or node.xml_id}")
-        elif kind in ("error", "escalation") and catching:
-            keys["bpmn"] = f"{kind} start"
-        sent_extra = self.reading.messages_out(node.xml_id)
-        if not catching and "send" not in keys and sent_extra:
-            keys["send"] = _sent(sent_extra[0])
-        node.keys.update(keys)
-
-    def _timer(self, definition: ET.Element, node: FlowNode, what: str) -> Json:
-        duration = text_of(next(iter(children(definition, "timeDuration")), None))
-        if node.kind == "startEvent":
-            return {"bpmn": "timer start"}
-        if duration and DURATION.match(duration):
-            return {"timer": duration}
-        given = next(
-            (
-                f"{c.tag.split('}')[-1]} {text_of(c)!r}"
-                for c in definition
-                if bpmn_name(c) in ("timeDuration", "timeDate", "timeCycle")
-            ),
-            "no time",
-        )
-        return {
-            "rewrite": f"The {what} waits for {given[:200]}: hrc's timers wait a fixed duration "
-            "(such as PT5M); give it one."
-        }
-
-    def _task_messages(self, node: FlowNode) -> None:
-        received = self.reading.message_in(node.xml_id)
-        if received is not None:
-            node.receive = _awaited(received)
-        sent = self.reading.messages_out(node.xml_id)
-        if sent:
-            node.keys.setdefault("send", _sent(sent[0]))
-
-    # Loops and multi-instance activities.
-
-    def _loops(self, element: ET.Element, node: FlowNode) -> None:
-        what = node.describe()
-        loop = next(iter(children(element, "standardLoopCharacteristics")), None)
-        if loop is not None:
-            condition = next(iter(children(loop, "loopCondition")), None)
-            text = text_of(condition)
-            guard = (
-                translate(text, condition.get("language") if condition is not None else None)
-                if text
-                else None
-            )
-            if guard is not None:
-                node.loop = {"guard": guard}
-            else:
-                node.loop = {
-                    "rewrite": f"The {what} loops "
-                    + (
-                        f"while {text[:200]!r}, which did not translate"
-                        if text
-                        else "without a condition"
-                    )
-                    + ": write the guard of repeating it."
-                }
-        multiple = next(iter(children(element, "multiInstanceLoopCharacteristics")), None)
-        if multiple is None:
-            return
-        cardinality = text_of(next(iter(children(multiple, "loopCardinality")), None))
-        sequential = multiple.get("isSequential") == "true"
-        if cardinality.isdigit() and 1 <= int(cardinality) <= MAX_COPIES and node.kind != "begin":
-            node.copies = (int(cardinality), sequential)
-            return
-        collection = next((v for k, v in multiple.attrib.items() if k.endswith("collection")), None)
-        if cardinality:
-            how = f"{cardinality[:200]!r} times"
-        elif collection:
-            how = f"once per item of {collection[:200]!r}"
-        else:
-            how = "a number of times known only at run time"
-        node.keys["rewrite"] = (
-            f"The {what} runs {how} ({'in sequence' if sequential else 'in parallel'}): it is "
-            "imported once; draw its copies."
-        )
 
     # After the whole process is read.
 
@@ -960,70 +770,6 @@ class ProcessReader:
                 continue
             self.synthetic_flow(node, target, node.scope)
 
-    def _inclusive_blocks(self) -> None:
-        """Finds each inclusive split's join: the inclusive gateway every branch reaches first."""
-        joins = {
-            n.xml_id
-            for n in self.graph.nodes
-            if n.kind == "inclusiveGateway" and len(n.incoming) > 1
-        }
-        claimed: set[str] = set()
-        for split in [
-            n for n in self.graph.nodes if n.kind == "inclusiveGateway" and len(n.outgoing) > 1
-        ]:
-            if len(split.incoming) > 1:
-                self.reading.fail(
-                    f"The {split.describe()} both joins and splits: draw an inclusive join and "
-                    "a separate inclusive split.",
-                    split.xml_id,
-                )
-                continue
-            if len(split.outgoing) > MAX_INCLUSIVE_BRANCHES:
-                self.reading.fail(
-                    f"The {split.describe()} has {len(split.outgoing)} branches; inclusive "
-                    f"gateways are imported with at most {MAX_INCLUSIVE_BRANCHES}.",
-                    split.xml_id,
-                )
-                continue
-            reached = [_reach(flow, joins) for flow in split.outgoing]
-            common = set.intersection(*[set(r) for r in reached]) if reached else set()
-            if not any(reached):
-                continue  # the branches never meet again: no join to tell
-            candidates = [j for j in reached[0] if j in common]
-            join = next(
-                (n for n in self.graph.nodes if candidates and n.xml_id == candidates[0]), None
-            )
-            mapping = self._branch_flows(split, join) if join is not None else None
-            if join is None or mapping is None:
-                self.reading.fail(
-                    f"The {split.describe()} splits into branches that do not all meet again at "
-                    "one inclusive gateway, one flow each: hrc imports inclusive gateways that "
-                    "form a block.",
-                    split.xml_id,
-                )
-                continue
-            split.inclusive_join = join
-            split.branch_flows = mapping
-            claimed.add(join.xml_id)
-        for join in [n for n in self.graph.nodes if n.xml_id in joins and n.xml_id not in claimed]:
-            if len(join.outgoing) <= 1 and join.xml_id not in self.refused:
-                self.reading.fail(
-                    f"The {join.describe()} merges branches no inclusive split of the same "
-                    "block started: hrc imports inclusive gateways that form a block.",
-                    join.xml_id,
-                )
-
-    def _branch_flows(self, split: FlowNode, join: FlowNode) -> dict[str, str] | None:
-        mapping: dict[str, str] = {}
-        for flow in split.outgoing:
-            arrivals = _arrivals(flow, join)
-            if len(arrivals) != 1:
-                return None
-            mapping[flow.xml_id] = arrivals[0].place
-        if len(set(mapping.values())) != len(join.incoming):
-            return None
-        return mapping
-
 
 @dataclass
 class _Callee:
@@ -1031,50 +777,3 @@ class _Callee:
 
     process: ET.Element | None = None
     pattern: Pattern | None = None
-
-
-def _awaited(name: str) -> Json:
-    return {"name": name, "correlation": dict(CORRELATION_AWAIT)}
-
-
-def _sent(name: str) -> Json:
-    return {"name": name, "correlation": dict(CORRELATION_SEND)}
-
-
-def _reach(flow: Flow, joins: set[str]) -> list[str]:
-    """The joins reachable from the flow without passing another, nearest first."""
-    seen: set[int] = set()
-    found: list[str] = []
-    frontier = [flow]
-    while frontier:
-        following: list[Flow] = []
-        for current in frontier:
-            if id(current) in seen:
-                continue
-            seen.add(id(current))
-            target = current.target
-            if target.xml_id in joins:
-                if target.xml_id not in found:
-                    found.append(target.xml_id)
-                continue
-            following += target.outgoing
-        frontier = following
-    return found
-
-
-def _arrivals(flow: Flow, join: FlowNode) -> list[Flow]:
-    """The join's incoming flows reachable from the flow."""
-    seen: set[int] = set()
-    arrivals: list[Flow] = []
-    stack = [flow]
-    while stack:
-        current = stack.pop()
-        if id(current) in seen:
-            continue
-        seen.add(id(current))
-        if current.target is join:
-            if current not in arrivals:
-                arrivals.append(current)
-            continue
-        stack += current.target.outgoing
-    return arrivals
