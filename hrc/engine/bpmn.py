@@ -199,6 +199,7 @@ class _Importer:
         self.sent: dict[str, list[str]] = {}
         self.signals_thrown: set[str] = set()
         self.elements: dict[str, ET.Element] = {}
+        self.extra_reported: set[int] = set()
         self.taken: set[str] = set()
         self.actors: dict[str, Json] = {}
         self.constraints: list[Json] = []
@@ -260,7 +261,7 @@ class _Importer:
         for element in self.root.iter():
             xml_id = element.get("id")
             if xml_id and _bpmn(element) is not None:
-                given = self._extra(element, f"element {xml_id}").get("id")
+                given = self._extra(element, f"element {xml_id}", report=False).get("id")
                 if isinstance(given, str) and given:
                     self.hrc_ids[xml_id] = given
                     self.taken.add(given)
@@ -274,8 +275,12 @@ class _Importer:
         self.taken.add(candidate)
         return candidate
 
-    def _extra(self, element: ET.Element, where: str) -> Json:
-        """The JSON object in the element's `<hrc:extra>`; {} (and an issue if broken) if none."""
+    def _extra(self, element: ET.Element, where: str, *, report: bool = True) -> Json:
+        """The JSON object in the element's `<hrc:extra>`; {} if none or broken.
+
+        A broken one is reported once per element, in the words of the first
+        reader that reports (the ids are collected first, silently).
+        """
         holder = next(iter(_children(element, "extensionElements")), None)
         if holder is None:
             return {}
@@ -284,18 +289,23 @@ class _Importer:
             return {}
         xml_id = element.get("id", "")
         ids = [xml_id] if xml_id else []
+        problem = None
+        data: object = None
         if len(blocks) > 1:
-            self.fail(f"The {where} has {len(blocks)} hrc:extra elements; one is allowed.", *ids)
-            return {}
-        try:
-            data = cast(object, json.loads(blocks[0].text or ""))
-        except (ValueError, RecursionError):
-            self.fail(f"The hrc:extra of the {where} is not JSON.", *ids)
-            return {}
-        if not isinstance(data, dict):
-            self.fail(f"The hrc:extra of the {where} must be a JSON object.", *ids)
-            return {}
-        return cast(Json, data)
+            problem = f"The {where} has {len(blocks)} hrc:extra elements; one is allowed."
+        else:
+            try:
+                data = cast(object, json.loads(blocks[0].text or ""))
+            except (ValueError, RecursionError):
+                problem = f"The hrc:extra of the {where} is not JSON."
+            if problem is None and not isinstance(data, dict):
+                problem = f"The hrc:extra of the {where} must be a JSON object."
+        if problem is None:
+            return cast(Json, data)
+        if report and id(element) not in self.extra_reported:
+            self.extra_reported.add(id(element))
+            self.fail(problem, *ids)
+        return {}
 
     # The file's root elements.
 

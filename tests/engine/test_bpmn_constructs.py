@@ -443,3 +443,16 @@ def test_a_looping_sub_process_goes_back_from_its_end_to_its_beginning() -> None
     assert again.extra == {"guard": "data.rough"}
     assert _run(pattern, {"rough": False}) == ["p"]
     assert check_pattern(pattern).sound is True
+
+
+def test_a_broken_hrc_extra_is_reported_once_naming_the_element() -> None:
+    error = refused(
+        bpmn(
+            '<startEvent id="s"/><task id="a" name="Pick"><extensionElements><hrc:extra>{no'
+            '</hrc:extra></extensionElements></task><endEvent id="e"/>'
+            + flows("f1: s -> a", "f2: a -> e")
+        )
+    )
+    assert [i.message for i in error.issues] == [
+        'The hrc:extra of the task "Pick" (a) is not JSON.'
+    ]
