@@ -160,9 +160,13 @@ def _timer(definition: ET.Element, node: FlowNode, what: str) -> Json:
 
 
 def task_messages(reading: Reading, node: FlowNode) -> None:
-    """A task a message flow reaches waits for it; one it leaves sends it."""
+    """A receive task a message flow reaches waits for it; a task it leaves sends it.
+
+    Other tasks a message flow reaches do not wait: BPMN gives only receive
+    tasks (and catch events) that meaning.
+    """
     received = reading.message_in(node.xml_id)
-    if received is not None:
+    if received is not None and node.kind == "receiveTask":
         node.receive = awaited(received)
     flows_out = reading.messages_out(node.xml_id)
     if flows_out:

@@ -456,3 +456,23 @@ def test_a_broken_hrc_extra_is_reported_once_naming_the_element() -> None:
     assert [i.message for i in error.issues] == [
         'The hrc:extra of the task "Pick" (a) is not JSON.'
     ]
+
+
+def test_only_a_receive_task_waits_for_the_message_flow_that_reaches_it() -> None:
+    text = f"""<definitions xmlns="{BPMN_NAMESPACE}" id="d" targetNamespace="urn:t">
+      <collaboration id="c"><participant id="p1" processRef="A"/>
+        <participant id="p2" processRef="B"/>
+        <messageFlow id="m1" name="go" sourceRef="a" targetRef="wait"/>
+        <messageFlow id="m2" name="fyi" sourceRef="a" targetRef="work"/></collaboration>
+      <process id="A"><startEvent id="s"/><task id="a"/><endEvent id="e"/>
+        {flows("f1: s -> a", "f2: a -> e")}</process>
+      <process id="B"><startEvent id="s2"/><receiveTask id="wait" name="Wait"/>
+        <userTask id="work"/><endEvent id="e2"/>
+        {flows("g1: s2 -> wait", "g2: wait -> work", "g3: work -> e2")}</process>
+    </definitions>"""
+    pattern = bpmn_to_pattern(text)
+    step = next(t for p in pattern.processes for t in p.transitions if t.label == "Wait: message")
+    assert step.extra["message"]["name"] == "go"
+    assert not any(
+        "work" in t.id and "message" in t.extra for p in pattern.processes for t in p.transitions
+    )
