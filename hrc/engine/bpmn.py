@@ -235,8 +235,15 @@ class _Importer:
         for container in [*processes, *collaborations]:
             self._constraints(container)
         if not self.issues and not built:
+            empty = [describe("process", i, e.get("name")) for i, e in self.processes.items()]
             self.fail(
-                "The file has no process with flow nodes (events, tasks, gateways) to import."
+                "The file has no process with flow nodes (events, tasks, gateways) to import"
+                + (
+                    f": the {', the '.join(empty)} {'is' if len(empty) == 1 else 'are'} empty."
+                    if empty
+                    else "."
+                ),
+                *self.processes,
             )
         if self.issues:
             raise FormatError(list(dict.fromkeys(self.issues)))
