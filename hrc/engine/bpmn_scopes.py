@@ -250,8 +250,6 @@ class ProcessReader:
         elif local in EVENT_KINDS and not self._event(element, node):
             self.refused.add(xml_id)
             return None
-        if local == "inclusiveGateway":
-            node.keys.setdefault("bpmn", "inclusiveGateway")
         return node, node
 
     # Activities with contents: sub-processes and call activities.
@@ -412,8 +410,8 @@ class ProcessReader:
         if process is not None:
             if called in self.calling:
                 self.reading.fail(
-                    f"The {what} calls process {called}, which is already being called on the "
-                    "way there: a recursive call cannot be flattened.",
+                    f"The {what} calls process {called}, which is calling it already: a "
+                    "recursive call cannot be flattened into one net.",
                     element.get("id", ""),
                 )
                 return None

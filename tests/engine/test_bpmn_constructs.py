@@ -476,3 +476,16 @@ def test_only_a_receive_task_waits_for_the_message_flow_that_reaches_it() -> Non
     assert not any(
         "work" in t.id and "message" in t.extra for p in pattern.processes for t in p.transitions
     )
+
+
+def test_a_recursive_call_is_refused_naming_the_call_activity() -> None:
+    text = f"""<definitions xmlns="{BPMN_NAMESPACE}" id="d" targetNamespace="urn:t">
+      <process id="Main"><startEvent id="s"/><callActivity id="call" calledElement="Sub"/>
+        <endEvent id="e"/>{flows("f1: s -> call", "f2: call -> e")}</process>
+      <process id="Sub"><startEvent id="s2"/><callActivity id="again" name="Again"
+        calledElement="Sub"/><endEvent id="e2"/>{flows("g1: s2 -> again", "g2: again -> e2")}
+      </process>
+    </definitions>"""
+    error = refused(text)
+    assert [i.elements for i in error.issues] == [("again",)]
+    assert 'call activity "Again" (again) calls process Sub' in error.issues[0].message
