@@ -15,7 +15,7 @@ of business process models in BPMN", Information and Software Technology 50
 | end event E | a silent transition per incoming flow into the net's sink place: E itself when there is one end event, else `<process>_end`. A node no flow leaves ends its path through an extra end (BPMN's implicit end) |
 | parallel gateway G (fork, join, or both) | one silent transition G consuming all incoming and producing all outgoing flows |
 | exclusive gateway G | a place where the choice or merge happens, with a silent transition per branch: a split keeps its incoming flow's place and gets a transition `G_<flow>` into each outgoing flow's place (the flow's condition becomes that transition's `guard`; the default flow's is "none of the others"); a merge gets a transition per incoming flow into the outgoing flow's place; a gateway with several of each gets its own place G between them |
-| condition on a flow | a `guard` in hrc's language (`${a > 3}`, `#{ok && !late}`, `a gt 3` become `data.a > 3`, `data.ok and not data.late`, ... see `bpmn_conditions`); one that does not translate (prose, XPath, method calls) leaves the branch without guard and with a `rewrite` key saying what to rewrite, so the model stays a draft. An empty `<conditionExpression/>` is no condition. Conditions (or a default flow) on the flows out of a task or event: a silent exclusive choice after it |
+| condition on a flow | a `guard` in hrc's language (`${a > 3}`, `#{ok && !late}`, `a gt 3` become `data.a > 3`, `data.ok and not data.late`, ... see `bpmn_conditions`); one that does not translate (prose, XPath, method calls) leaves the branch without guard and with a `rewrite` key saying what to rewrite, so the model stays a draft. An empty `<conditionExpression/>` is no condition. The variables a translated condition reads become the document's `data` with a default of the type they are compared with (0, "", else false), so a case can start and its start form asks for them. Conditions (or a default flow) on the flows out of a task or event: a silent exclusive choice after it |
 | event-based gateway G | a deferred choice: the events after G consume the same place, so the first to happen takes the branch |
 | inclusive gateway G | where G splits into at most 4 branches that meet again at one inclusive join (a block): a silent transition per non-empty subset of branches (guarded by its conditions), each also marking a place that tells the join which subset to wait for, and a join transition per subset. A split whose branches never meet again needs no join. A join no split of its block started, or a split with more branches, is refused |
 | sub-process S (and an inlined call activity) | flattened into the process between two silent steps, `S: begins` (id S) and `S: ends`: the first marks the contents' source place `S_start` and a scope place `S_scope`, the second takes the contents' sink place `S_done` and `S_scope`. Its ids keep theirs (a call activity's get `<call id>.` in front). A sub-process without contents is a task |
@@ -200,6 +200,8 @@ class _Importer:
         self.signals_thrown: set[str] = set()
         self.elements: dict[str, ET.Element] = {}
         self.extra_reported: set[int] = set()
+        self.data: dict[str, object] = {}
+        """The case data the file's translated conditions read, with their defaults."""
         self.taken: set[str] = set()
         self.actors: dict[str, Json] = {}
         self.constraints: list[Json] = []
@@ -247,6 +249,9 @@ class _Importer:
             )
         if self.issues:
             raise FormatError(list(dict.fromkeys(self.issues)))
+        given = document.get("data", {})
+        if self.data and isinstance(given, dict):
+            document["data"] = {**self.data, **given}
         rank = {actor_id: index for index, actor_id in reversed(list(enumerate(order)))}
         document["actors"] = sorted(
             self.actors.values(), key=lambda actor: rank.get(actor["id"], len(rank))
@@ -430,6 +435,8 @@ class _Importer:
             net.ends(graph.starts.get(scope_id, []), scope, start=True)
             net.ends(graph.ends.get(scope_id, []), scope, start=False)
         net.finish()
+        for key, value in graph.data.items():
+            self.data.setdefault(key, value)
         data: Json = {"id": process_id, "workpiece": _workpiece(element, pool, process_id)}
         data["actors"] = list(dict.fromkeys(performers.values()))
         if element.get("name"):

@@ -9,6 +9,7 @@ operators `eq ne lt gt le ge and or not`) and returns None for anything else
 importer then marks as a condition to rewrite.
 """
 
+import ast
 import re
 
 from hrc.engine.expressions import check
@@ -76,3 +77,33 @@ def _tokens(body: str) -> list[str] | None:
         else:
             words.append(token)
     return words
+
+
+def data_defaults(guard: str) -> dict[str, object]:
+    """The case data a translated guard reads, each key with a default of the type it is
+    compared with (0, "", None), else false: what a case starts with until its start form
+    says otherwise."""
+    tree = ast.parse(guard, mode="eval")
+    defaults: dict[str, object] = {}
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Compare):
+            continue
+        operands = [node.left, *node.comparators]
+        constants = [o.value for o in operands if isinstance(o, ast.Constant)]
+        for operand in operands:
+            key = _data_key(operand)
+            if key is not None and constants:
+                value = constants[0]
+                default = type(value)() if isinstance(value, int | float | str) else None
+                defaults.setdefault(key, default)
+    for node in ast.walk(tree):
+        key = _data_key(node)
+        if key is not None:
+            defaults.setdefault(key, False)
+    return defaults
+
+
+def _data_key(node: ast.AST) -> str | None:
+    if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+        return node.attr if node.value.id == "data" else None
+    return None

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from hrc.engine.bpmn_conditions import translate
+from hrc.engine.bpmn_conditions import data_defaults, translate
 from hrc.engine.bpmn_events import (
     Reading,
     Trigger,
@@ -99,6 +99,8 @@ class ProcessGraph:
     scopes: dict[str, Scope] = field(default_factory=dict)
     tasks: dict[str, list[str]] = field(default_factory=dict)
     """hrc id of each task -> the XML ids its lane is looked up by: its own, its outermost activity's."""
+    data: dict[str, object] = field(default_factory=dict)
+    """The case data its translated conditions read, with defaults (`bpmn_conditions.data_defaults`)."""
     inlined: list[tuple[Scope, str, Pattern]] = field(default_factory=list)
     """Published patterns called: the call activity's scope, its id, the pattern."""
 
@@ -155,6 +157,11 @@ class ProcessReader:
         self._links()
         inclusive_blocks(self.graph.nodes, self.reading.fail)
         deferred_choices(self.graph.nodes)
+        for node in self.graph.nodes:  # conditional events and loops: always another engine's
+            for guard in (node.keys.get("guard"), (node.loop or {}).get("guard")):
+                if isinstance(guard, str):
+                    for key, value in data_defaults(guard).items():
+                        self.graph.data.setdefault(key, value)
         return self.graph
 
     # Containers: the process, sub-processes, called processes.
@@ -592,6 +599,9 @@ class ProcessReader:
         guard = translate(text, language)
         if guard is not None:
             flow.guard = guard
+            if guard != text.strip():  # written for another engine: its variables start empty
+                for key, value in data_defaults(guard).items():
+                    self.graph.data.setdefault(key, value)
         else:
             shown = f" ({language})" if language else ""
             flow.rewrite = (

@@ -489,3 +489,17 @@ def test_a_recursive_call_is_refused_naming_the_call_activity() -> None:
     error = refused(text)
     assert [i.elements for i in error.issues] == [("again",)]
     assert 'call activity "Again" (again) calls process Sub' in error.issues[0].message
+
+
+def test_variables_of_translated_conditions_become_case_data_with_defaults() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><exclusiveGateway id="x" default="low"/><task id="big"/>'
+        '<task id="small"/><exclusiveGateway id="m"/><endEvent id="e"/>'
+        '<sequenceFlow id="high" sourceRef="x" targetRef="big">'
+        "<conditionExpression>${amount &gt; 1000 &amp;&amp; region == 'EU' &amp;&amp; !blocked}"
+        "</conditionExpression></sequenceFlow>"
+        + flows("f1: s -> x", "low: x -> small", "f2: big -> m", "f3: small -> m", "f4: m -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    assert pattern.extra["data"] == {"amount": 0, "region": "", "blocked": False}
+    assert _run(pattern, CaseNet(pattern).initial_data()) == ["small"]
