@@ -159,15 +159,16 @@ def _timer(definition: ET.Element, node: FlowNode, what: str) -> Json:
     }
 
 
-def task_messages(reading: Reading, node: FlowNode) -> None:
-    """A receive task a message flow reaches waits for it; a task it leaves sends it.
+def task_messages(reading: Reading, node: FlowNode, message_ref: str | None) -> None:
+    """A receive task waits for its message: the one a message flow brings, else the one it
+    names; a task a message flow leaves sends it.
 
     Other tasks a message flow reaches do not wait: BPMN gives only receive
     tasks (and catch events) that meaning.
     """
-    received = reading.message_in(node.xml_id)
-    if received is not None and node.kind == "receiveTask":
-        node.receive = awaited(received)
+    if node.kind == "receiveTask":
+        received = reading.message_in(node.xml_id) or reading.definition_name(message_ref)
+        node.receive = awaited(received or node.name or node.xml_id)
     flows_out = reading.messages_out(node.xml_id)
     if flows_out:
         node.keys.setdefault("send", sent(flows_out[0]))

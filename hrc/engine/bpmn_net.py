@@ -270,16 +270,20 @@ class FlowNet:
                 transition["cancels"] = cancels
 
     def _merged_input(self, node: FlowNode) -> str | None:
-        """The one place the node's transition consumes: several incoming flows merge first."""
-        if len(node.incoming) == 1 and not node.receive and not node.loop:
-            return node.incoming[0].place
-        if not node.incoming and not node.receive and not node.loop:
-            return None
-        merged = self.place(self.fresh(f"{node.hrc_id}_in"), node.scope)
-        for flow in node.incoming:
-            step = self.transition(self.fresh(f"{node.hrc_id}_{flow.xml_id}"), node.scope)
-            self.arc(flow.place, step)
-            self.arc(step, merged)
+        """The one place the node's transition consumes: several incoming flows merge first.
+
+        A receive task's message step comes before it and takes that place
+        itself, so after an event-based gateway it races like a catch event.
+        """
+        merged: str | None = None
+        if len(node.incoming) == 1 and not node.loop:
+            merged = node.incoming[0].place
+        elif node.incoming or node.loop:
+            merged = self.place(self.fresh(f"{node.hrc_id}_in"), node.scope)
+            for flow in node.incoming:
+                step = self.transition(self.fresh(f"{node.hrc_id}_{flow.xml_id}"), node.scope)
+                self.arc(flow.place, step)
+                self.arc(step, merged)
         if node.receive is None:
             return merged
         received = self.place(self.fresh(f"{node.hrc_id}_received"), node.scope)
@@ -289,7 +293,10 @@ class FlowNet:
             label=f"{node.name or node.hrc_id}: message",
             extra={"message": node.receive},
         )
-        self.arc(merged, step)
+        for place in [merged] if merged is not None else node.pre:
+            self.arc(place, step)
+        if merged is None:
+            node.pre = []  # a task in a scope of its own: the message step takes its input
         self.arc(step, received)
         return received
 

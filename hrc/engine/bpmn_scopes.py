@@ -252,7 +252,7 @@ class ProcessReader:
         node.default = element.get("default")
         if local in TASK_KINDS:
             self.graph.tasks[node.hrc_id] = [xml_id] + ([outer] if outer else [])
-            task_messages(self.reading, node)
+            task_messages(self.reading, node, element.get("messageRef"))
             mark_loops(element, node)
         elif local in EVENT_KINDS and not self._event(element, node):
             self.refused.add(xml_id)
@@ -291,7 +291,7 @@ class ProcessReader:
                     f"The {what} names no called element: imported as one task; draw "
                     "the tasks it calls in its place."
                 )
-            task_messages(self.reading, node)
+            task_messages(self.reading, node, element.get("messageRef"))
             mark_loops(element, node)
             return node, node
         begin = self._node("begin", xml_id, hrc_id, name, scope, self.reading.extra(element, what))

@@ -503,3 +503,37 @@ def test_variables_of_translated_conditions_become_case_data_with_defaults() -> 
     pattern = bpmn_to_pattern(text)
     assert pattern.extra["data"] == {"amount": 0, "region": "", "blocked": False}
     assert _run(pattern, CaseNet(pattern).initial_data()) == ["small"]
+
+
+def test_a_receive_task_after_an_event_based_gateway_races_for_the_same_place() -> None:
+    text = f"""<definitions xmlns="{BPMN_NAMESPACE}" id="d" targetNamespace="urn:t">
+      <collaboration id="c"><participant id="p1" processRef="A"/>
+        <participant id="p2" processRef="B"/>
+        <messageFlow id="m1" name="order" sourceRef="a" targetRef="take"/></collaboration>
+      <process id="A"><startEvent id="s"/><task id="a"/><endEvent id="e"/>
+        {flows("f1: s -> a", "f2: a -> e")}</process>
+      <process id="B"><startEvent id="s2"/><eventBasedGateway id="race"/>
+        <receiveTask id="take" name="Take order"/>
+        <intermediateCatchEvent id="idle"><timerEventDefinition><timeDuration>PT1H</timeDuration>
+        </timerEventDefinition></intermediateCatchEvent><endEvent id="e2"/><endEvent id="e3"/>
+        {flows("g1: s2 -> race", "g2: race -> take", "g3: race -> idle", "g4: take -> e2")}
+        {flows("g5: idle -> e3")}</process>
+    </definitions>"""
+    pattern = bpmn_to_pattern(text)
+    racing = {t for p in pattern.processes for s, t in p.arcs if s == "g1"}
+    assert racing == {"idle", "take_receive"}
+
+
+def test_a_receive_task_with_a_boundary_event_waits_for_its_message_inside_its_scope() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><receiveTask id="take" name="Take part" messageRef="m"/>'
+        '<endEvent id="e"/><boundaryEvent id="late" attachedToRef="take"><timerEventDefinition>'
+        "<timeDuration>PT5M</timeDuration></timerEventDefinition></boundaryEvent>"
+        '<endEvent id="e2"/>' + flows("f1: s -> take", "f2: take -> e", "f3: late -> e2"),
+        outside='<message id="m" name="part"/>',
+    )
+    pattern = bpmn_to_pattern(text)
+    assert _transition(pattern, "take_receive").extra["message"]["name"] == "part"
+    assert {("take_start", "take_receive"), ("take_receive", "take_received")} <= _arcs(pattern)
+    assert ("take_start", "take") not in _arcs(pattern)
+    assert not [e for e in check_pattern(pattern).errors if e.code == "not-workflow-net"]
