@@ -11,11 +11,27 @@ of business process models in BPMN", Information and Software Technology 50
 | sequence flow f | place f (its name in the place's `name`) |
 | task T (task, userTask, manualTask, serviceTask, scriptTask, businessRuleTask, sendTask, receiveTask) | transition T performed by its lane's actor, labelled with its name (a kind other than `task` kept in its `bpmn` key); arcs from its incoming and to its outgoing flows' places. Several incoming flows merge first (the paper's normalisation: an exclusive merge, a silent transition per flow into a place `T_in`); several outgoing flows all get a token (a parallel split) |
 | none intermediate event E | silent transition E, with the same arcs as a task |
-| start event S | the net's source place: S itself when the process has one start event, each start event then fires through a silent transition into its outgoing flows. With several start events the source place is `<process>_start` and each start event is a silent transition S out of it (an instance starts at one of them) |
-| end event E | the net's sink place, in the same way: E when there is one, else `<process>_end`; every incoming flow reaches it through a silent transition |
+| start event S | a silent transition from the net's source place into its outgoing flows. The source place is S itself when the process has one start event (the step gets a fresh id), else `<process>_start` with each start event a transition S out of it (an instance starts at one of them). A process without start events starts at every node no flow enters (BPMN's implicit start) |
+| end event E | a silent transition per incoming flow into the net's sink place: E itself when there is one end event, else `<process>_end`. A node no flow leaves ends its path through an extra end (BPMN's implicit end) |
 | parallel gateway G (fork, join, or both) | one silent transition G consuming all incoming and producing all outgoing flows |
 | exclusive gateway G | a place where the choice or merge happens, with a silent transition per branch: a split keeps its incoming flow's place and gets a transition `G_<flow>` into each outgoing flow's place (the flow's condition becomes that transition's `guard`; the default flow's is "none of the others"); a merge gets a transition per incoming flow into the outgoing flow's place; a gateway with several of each gets its own place G between them |
-| lane | an actor (id: the lane's id), performing the tasks in it (the innermost lane when lanes nest); lanes without tasks are left out |
+| condition on a flow | a `guard` in hrc's language (`${a > 3}`, `#{ok && !late}`, `a gt 3` become `data.a > 3`, `data.ok and not data.late`, ... see `bpmn_conditions`); one that does not translate (prose, XPath, method calls) leaves the branch without guard and with a `rewrite` key saying what to rewrite, so the model stays a draft. An empty `<conditionExpression/>` is no condition. The variables a translated condition reads become the document's `data` with a default of the type they are compared with (0, "", else false), so a case can start and its start form asks for them. Conditions (or a default flow) on the flows out of a task or event: a silent exclusive choice after it |
+| event-based gateway G | a deferred choice: the events after G consume the same place, so the first to happen takes the branch |
+| inclusive gateway G | where G splits into at most 4 branches that meet again at one inclusive join (a block): a silent transition per non-empty subset of branches (guarded by its conditions), each also marking a place that tells the join which subset to wait for, and a join transition per subset. A split whose branches never meet again needs no join. A join no split of its block started, or a split with more branches, is refused |
+| sub-process S (and an inlined call activity) | flattened into the process between two silent steps, `S: begins` (id S) and `S: ends`: the first marks the contents' source place `S_start` and a scope place `S_scope`, the second takes the contents' sink place `S_done` and `S_scope`. Its ids keep theirs (a call activity's get `<call id>.` in front). A sub-process without contents is a task |
+| call activity C | its `calledElement` names a process of the file: that process is inlined as a sub-process (and not imported on its own; a call that reaches itself again is refused); a global task, or no called element: a task (the latter with `rewrite`); else `called` finds the organisation's published pattern of that name (the calledElement, then C's name): its net is inlined between C's steps, its actors and constraints with `<C>.` in front. Unresolved: refused, naming what it calls |
+| boundary event B on activity A | a silent transition consuming A's scope place (a task with boundary events gets a scope of its own: `A: begins` marks its input and the scope place, `A: ends` takes its output and the scope place). Interrupting: `cancels` every place and task inside A. Non-interrupting: an armed place marked by A's begin step lets B fire once per activation; B gives the scope place back, and A's end step `cancels` the armed place |
+| message event | catching (intermediate, boundary, or start fed by a message flow): `message` named after the BPMN message, awaited with `{"case": "case.id"}`; throwing (intermediate, end): `send`. Message flows between flow nodes of the file's processes: `send` on the sender (task or event), `message` on the receiving event's transition, or on a silent step in front of a receive task (which, reached by no message flow, waits for the message it names; other tasks a message flow reaches do not wait for it, as in BPMN). Message flows to or from a pool without a process (a black box) are ignored |
+| signal event | as a message named `signal:<signal name>` |
+| timer event | `"timer": "<ISO duration>"` from its timeDuration; a timeDate, timeCycle or expression: `rewrite` |
+| conditional event | a `guard` from its condition, else `rewrite` |
+| link events | the throw event jumps to the catch event of the same name |
+| error and escalation end events | thrown to the nearest enclosing activity's boundary event that catches them: the end event's transition takes that activity's scope place, `cancels` its contents (interrupting) and marks the boundary event's outgoing flows. Uncaught, an error end `cancels` the whole process and ends it; an escalation ends its path. An error or escalation boundary event nothing inside throws to waits for a message `error:<name>` (or `escalation:<name>`) |
+| terminate end event | its transitions `cancels` every place and task of its scope (process or sub-process) |
+| start event with a trigger | a message start no message flow feeds, a timer, signal (no signal thrown in the file), conditional, error or escalation start: a none start; the kind stays in its `bpmn` key |
+| standard loop | after the task, a silent step back to its input (the loop condition as guard, else `rewrite`) and one onwards |
+| multi-instance task | loopCardinality a whole number up to 20: that many copies, side by side (parallel) or one after the other (sequential), ids `T`, `T_2`, ...; else one instance with `rewrite` |
+| lane | an actor (id: the lane's id), performing the tasks in it (the innermost lane when lanes nest); lanes without tasks are left out. A task inside a sub-process or called process is in its own lane, else its outermost activity's, else its pool's |
 | pool without lanes | one actor: the participant, or `<process>_actor` |
 | process | a process of the pattern (several pools: several processes, as in Coexistence); its workpiece is its `hrc:workpiece` attribute, else the name of its pool, else its own name or id (wpassign is total) |
 
@@ -29,14 +45,15 @@ holds, as a JSON object, the keys of its `hrc-pattern/1` object the BPMN part
 does not carry (task configuration, an id XML cannot hold, ...), and overrides
 it on import: that is how our own exports come back with everything.
 
-What the mapping does not cover is refused with a FormatError that names the
-element: inclusive, complex and event-based gateways, subprocesses and call
-activities, boundary events, events with a definition (timer, message, ...),
-loop and multi-instance tasks, message flows, choreographies and
-conversations, and conditions on flows out of anything but an exclusive
-gateway. Nothing else is read from the file, so a refused import creates
-nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the pattern in
-its actors' lanes.
+What the mapping does not cover is refused with a FormatError whose messages
+name each element once, by kind, name and id (`task "Check order" (sid-89...)`),
+at every level of the file, and say nothing of the flows that touch a refused
+element: complex gateways, ad-hoc sub-processes, transactions, compensation
+(compensation events, boundary events and handlers), event sub-processes,
+unresolved call activities, inclusive gateways outside a block, choreographies
+and conversations. Nothing else is read from the file, so a refused import
+creates nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the
+pattern in its actors' lanes.
 
 Exclusive gateways choose when they are reached (BPMN's data-based choice),
 not when a task starts: a round trip through `pattern_to_bpmn` keeps the tasks,
@@ -47,7 +64,7 @@ choice between two tasks is then made by a silent step just before them.
 import json
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from io import BytesIO
 from typing import Any, cast
 
@@ -58,79 +75,78 @@ from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-igno
     iterparse as _safe_iterparse,
 )
 
-from hrc.engine.bpmn_net import EVENT_KINDS, GATEWAY_KINDS, TASK_KINDS, Flow, FlowNet, FlowNode
+from hrc.engine.bpmn_net import FlowNet, Scope, describe
+from hrc.engine.bpmn_scopes import FLOW_NODE_KINDS, GLOBAL_TASKS, ProcessGraph, ProcessReader
+from hrc.engine.bpmn_xml import BPMN_NAMESPACE, HRC_NAMESPACE
+from hrc.engine.bpmn_xml import bpmn_name as _bpmn
+from hrc.engine.bpmn_xml import children as _children
+from hrc.engine.bpmn_xml import hrc_attribute as _hrc
+from hrc.engine.bpmn_xml import local_name as _local
 from hrc.engine.document import FORMAT, FormatError, read_pattern
 from hrc.engine.issues import Issue, error
 from hrc.engine.model import Pattern
 from hrc.engine.pnml import parse_xml
 
-BPMN_NAMESPACE = "http://www.omg.org/spec/BPMN/20100524/MODEL"
+__all__ = [
+    "BPMNDI_NAMESPACE",
+    "BPMN_NAMESPACE",
+    "DC_NAMESPACE",
+    "DI_NAMESPACE",
+    "HRC_NAMESPACE",
+    "bpmn_to_document",
+    "bpmn_to_pattern",
+    "is_bpmn",
+]
+
 BPMNDI_NAMESPACE = "http://www.omg.org/spec/BPMN/20100524/DI"
 DC_NAMESPACE = "http://www.omg.org/spec/DD/20100524/DC"
 DI_NAMESPACE = "http://www.omg.org/spec/DD/20100524/DI"
-HRC_NAMESPACE = "urn:hrc:bpmn:1"
-"""Our attributes (actorType, constraint, workpiece, declaredPattern) and the `extra` element."""
 
 Json = dict[str, Any]
+Called = Callable[[list[str]], Pattern | None]
+"""Finds the organisation's published pattern for a call activity, by its candidate names."""
 
-FLOW_NODE_KINDS = TASK_KINDS | GATEWAY_KINDS | EVENT_KINDS
-# Elements of a process that carry no control flow: read elsewhere or ignored.
-PROCESS_IGNORED = frozenset(
+ROOT_REFUSED = frozenset({"choreography", "globalChoreographyTask", "globalConversation"})
+COLLABORATION_IGNORED = frozenset(
     {
         "documentation",
         "extensionElements",
-        "auditing",
-        "monitoring",
-        "property",
-        "laneSet",
-        "sequenceFlow",
+        "participant",
         "association",
         "textAnnotation",
         "group",
-        "dataObject",
-        "dataObjectReference",
-        "dataStoreReference",
-        "ioSpecification",
-        "ioBinding",
-        "resourceRole",
-        "performer",
-        "humanPerformer",
-        "potentialOwner",
-        "correlationSubscription",
-        "supports",
+        "messageFlow",
+        "conversation",
+        "subConversation",
+        "callConversation",
+        "conversationLink",
+        "conversationAssociation",
+        "participantAssociation",
+        "messageFlowAssociation",
+        "correlationKey",
     }
 )
-ROOT_REFUSED = frozenset(
-    {"choreography", "globalChoreographyTask", "globalConversation", "globalTask"}
-)
-COLLABORATION_IGNORED = frozenset(
-    {"documentation", "extensionElements", "participant", "association", "textAnnotation", "group"}
-)
-REFUSED_WHY = {
-    "inclusiveGateway": "an inclusive (OR) gateway has no Petri net mapping in hrc",
-    "complexGateway": "a complex gateway has no Petri net mapping in hrc",
-    "eventBasedGateway": "an event-based gateway waits for events hrc does not model",
-    "subProcess": "subprocesses are not mapped: draw its tasks in the process",
-    "adHocSubProcess": "ad-hoc subprocesses are not mapped",
-    "transaction": "transactions are not mapped",
-    "callActivity": "call activities are not mapped: draw the called tasks in the process",
-    "boundaryEvent": "boundary events (exceptions) are not mapped",
-    "messageFlow": "message flows between pools are not mapped",
-}
+DEFINITIONS = frozenset({"message", "signal", "error", "escalation"})
 COBOT_NAME = re.compile(r"cobot|robot", re.IGNORECASE)
 
 
-def bpmn_to_pattern(text: str | bytes) -> Pattern:
+def bpmn_to_pattern(text: str | bytes, called: Called | None = None) -> Pattern:
     """Reads a BPMN 2.0 file; raises FormatError, naming the element, when it cannot.
 
-    DTDs are refused, so no entity can expand or reach outside the text.
+    `called` finds the published pattern a call activity names when no process
+    of the file has that id (None: nothing is published). DTDs are refused, so
+    no entity can expand or reach outside the text.
     """
-    return read_pattern(bpmn_to_document(text))
+    return read_pattern(bpmn_to_document(text, called))
 
 
-def bpmn_to_document(text: str | bytes) -> Json:
+def bpmn_to_document(text: str | bytes, called: Called | None = None) -> Json:
     """The `hrc-pattern/1` document of a BPMN file, before `read_pattern` checks its shape."""
-    return _Importer(parse_xml(text, "BPMN")).document()
+    return _Importer(parse_xml(text, "BPMN"), called or _nothing_published).document()
+
+
+def _nothing_published(names: list[str]) -> Pattern | None:
+    return None
 
 
 def is_bpmn(text: str | bytes) -> bool:
@@ -157,32 +173,6 @@ def _refuse(message: str, *elements: str) -> FormatError:
     return FormatError([error("format", message, *elements)])
 
 
-def _local(element: ET.Element) -> tuple[str, str]:
-    """(namespace, local name) of an element; comments and processing instructions have none."""
-    tag = element.tag
-    if not isinstance(tag, str):
-        return ("", "")
-    if tag.startswith("{"):
-        namespace, _, local = tag[1:].partition("}")
-        return namespace, local
-    return "", tag
-
-
-def _bpmn(element: ET.Element) -> str | None:
-    """The local name of a BPMN element; None for elements of other namespaces."""
-    namespace, local = _local(element)
-    return local if namespace == BPMN_NAMESPACE else None
-
-
-def _children(element: ET.Element, local: str) -> list[ET.Element]:
-    tag = f"{{{BPMN_NAMESPACE}}}{local}"
-    return [child for child in element if child.tag == tag]
-
-
-def _hrc(element: ET.Element, name: str) -> str | None:
-    return element.get(f"{{{HRC_NAMESPACE}}}{name}")
-
-
 def _workpiece(process: ET.Element, pool: ET.Element | None, process_id: str) -> str:
     """What the process works on: ours as exported, else named after its pool or itself."""
     candidates = [
@@ -196,9 +186,22 @@ def _workpiece(process: ET.Element, pool: ET.Element | None, process_id: str) ->
 class _Importer:
     """Turns a BPMN tree into an `hrc-pattern/1` document, collecting every refusal."""
 
-    def __init__(self, root: ET.Element) -> None:
+    def __init__(self, root: ET.Element, called: Called) -> None:
         self.root = root
+        self.called = called
         self.issues: list[Issue] = []
+        self.processes: dict[str, ET.Element] = {}
+        self.global_tasks: dict[str, ET.Element] = {}
+        self.definitions: dict[str, str] = {}
+        """Id of each message, signal, error and escalation -> its name (else its id)."""
+        self.received: dict[str, str] = {}
+        """XML id of a flow node a message flow reaches -> the message's name."""
+        self.sent: dict[str, list[str]] = {}
+        self.signals_thrown: set[str] = set()
+        self.elements: dict[str, ET.Element] = {}
+        self.extra_reported: set[int] = set()
+        self.data: dict[str, object] = {}
+        """The case data the file's translated conditions read, with their defaults."""
         self.taken: set[str] = set()
         self.actors: dict[str, Json] = {}
         self.constraints: list[Json] = []
@@ -234,11 +237,21 @@ class _Importer:
         for container in [*processes, *collaborations]:
             self._constraints(container)
         if not self.issues and not built:
+            empty = [describe("process", i, e.get("name")) for i, e in self.processes.items()]
             self.fail(
-                "The file has no process with flow nodes (events, tasks, gateways) to import."
+                "The file has no process with flow nodes (events, tasks, gateways) to import"
+                + (
+                    f": the {', the '.join(empty)} {'is' if len(empty) == 1 else 'are'} empty."
+                    if empty
+                    else "."
+                ),
+                *self.processes,
             )
         if self.issues:
             raise FormatError(list(dict.fromkeys(self.issues)))
+        given = document.get("data", {})
+        if self.data and isinstance(given, dict):
+            document["data"] = {**self.data, **given}
         rank = {actor_id: index for index, actor_id in reversed(list(enumerate(order)))}
         document["actors"] = sorted(
             self.actors.values(), key=lambda actor: rank.get(actor["id"], len(rank))
@@ -254,12 +267,13 @@ class _Importer:
         for element in self.root.iter():
             xml_id = element.get("id")
             if xml_id:
+                self.elements.setdefault(xml_id, element)
                 self.taken.add(xml_id)
                 self.hrc_ids[xml_id] = xml_id
         for element in self.root.iter():
             xml_id = element.get("id")
             if xml_id and _bpmn(element) is not None:
-                given = self._extra(element, f"element {xml_id}").get("id")
+                given = self._extra(element, f"element {xml_id}", report=False).get("id")
                 if isinstance(given, str) and given:
                     self.hrc_ids[xml_id] = given
                     self.taken.add(given)
@@ -273,8 +287,12 @@ class _Importer:
         self.taken.add(candidate)
         return candidate
 
-    def _extra(self, element: ET.Element, where: str) -> Json:
-        """The JSON object in the element's `<hrc:extra>`; {} (and an issue if broken) if none."""
+    def _extra(self, element: ET.Element, where: str, *, report: bool = True) -> Json:
+        """The JSON object in the element's `<hrc:extra>`; {} if none or broken.
+
+        A broken one is reported once per element, in the words of the first
+        reader that reports (the ids are collected first, silently).
+        """
         holder = next(iter(_children(element, "extensionElements")), None)
         if holder is None:
             return {}
@@ -283,58 +301,111 @@ class _Importer:
             return {}
         xml_id = element.get("id", "")
         ids = [xml_id] if xml_id else []
+        problem = None
+        data: object = None
         if len(blocks) > 1:
-            self.fail(f"The {where} has {len(blocks)} hrc:extra elements; one is allowed.", *ids)
-            return {}
-        try:
-            data = cast(object, json.loads(blocks[0].text or ""))
-        except (ValueError, RecursionError):
-            self.fail(f"The hrc:extra of the {where} is not JSON.", *ids)
-            return {}
-        if not isinstance(data, dict):
-            self.fail(f"The hrc:extra of the {where} must be a JSON object.", *ids)
-            return {}
-        return cast(Json, data)
+            problem = f"The {where} has {len(blocks)} hrc:extra elements; one is allowed."
+        else:
+            try:
+                data = cast(object, json.loads(blocks[0].text or ""))
+            except (ValueError, RecursionError):
+                problem = f"The hrc:extra of the {where} is not JSON."
+            if problem is None and not isinstance(data, dict):
+                problem = f"The hrc:extra of the {where} must be a JSON object."
+        if problem is None:
+            return cast(Json, data)
+        if report and id(element) not in self.extra_reported:
+            self.extra_reported.add(id(element))
+            self.fail(problem, *ids)
+        return {}
 
     # The file's root elements.
 
     def _root_elements(self) -> tuple[list[ET.Element], list[ET.Element]]:
+        """The processes to import (pools, and processes no call activity inlines) and collaborations."""
         processes, collaborations = [], []
         for child in self.root:
-            local = _bpmn(child)
+            local = _bpmn(child) or ""
+            xml_id = child.get("id", "")
             if local == "process":
-                if any(_bpmn(node) in FLOW_NODE_KINDS | set(REFUSED_WHY) for node in child):
+                self.processes[xml_id] = child
+                if any(
+                    _bpmn(node) in FLOW_NODE_KINDS | {"subProcess", "callActivity"}
+                    for node in child
+                ):
                     processes.append(child)
             elif local == "collaboration":
                 collaborations.append(child)
-            elif local in ROOT_REFUSED or (local or "").startswith(
-                ("choreography", "conversation")
-            ):
+            elif local in GLOBAL_TASKS:
+                self.global_tasks[xml_id] = child
+            elif local in DEFINITIONS:
+                self.definitions[xml_id] = (child.get("name") or "").strip() or xml_id
+            elif local in ROOT_REFUSED or local.startswith(("choreography", "conversation")):
+                what = describe(local, xml_id, child.get("name"))
                 self.fail(
-                    f"The <{local}> {child.get('id', '')} is not mapped: hrc imports processes, "
-                    "pools and lanes.",
-                    *([child.get("id", "")] if child.get("id") else []),
+                    f"The {what} cannot be imported: hrc imports processes, pools and lanes.",
+                    *([xml_id] if xml_id else []),
                 )
-        return processes, collaborations
+        called = {
+            element.get("calledElement", "")
+            for process in processes
+            for element in process.iter(f"{{{BPMN_NAMESPACE}}}callActivity")
+        }
+        return [p for p in processes if p.get("id") not in called], collaborations
 
     def _participants(self, collaborations: list[ET.Element]) -> dict[str, ET.Element]:
-        """Process id -> its participant (pool); refuses what a collaboration holds beyond pools."""
+        """Process id -> its participant (pool); reads message flows; refuses the rest."""
         participants: dict[str, ET.Element] = {}
         for collaboration in collaborations:
             for child in collaboration:
                 local = _bpmn(child)
-                if local is None or local in COLLABORATION_IGNORED:
-                    if local == "participant" and child.get("processRef"):
-                        participants.setdefault(child.get("processRef", ""), child)
-                    continue
-                self._refuse_element(child, local)
+                if local == "participant" and child.get("processRef"):
+                    participants.setdefault(child.get("processRef", ""), child)
+                elif local == "messageFlow":
+                    self._message_flow(child)
+                elif local is not None and local not in COLLABORATION_IGNORED:
+                    self._refuse_element(child, local)
+        for process in self.processes.values():
+            for element in process.iter():
+                if _bpmn(element) == "signalEventDefinition" and element.get("signalRef"):
+                    name = self.definitions.get(element.get("signalRef", ""), "")
+                    self.signals_thrown.add(f"signal:{name}")
         return participants
+
+    def _message_flow(self, flow: ET.Element) -> None:
+        """A message between two flow nodes of the file's processes; pools as ends are ignored.
+
+        Its name is the BPMN message's it (or its sender) refers to, else its own
+        name, else its id.
+        """
+        source, target = flow.get("sourceRef", ""), flow.get("targetRef", "")
+        named = [
+            self.definitions.get(flow.get("messageRef", "")),
+            *self._event_message(source),
+            *self._event_message(target),
+            (flow.get("name") or "").strip() or None,
+            flow.get("id", ""),
+        ]
+        # Every flow into one receiver carries the name it awaits.
+        name = self.received.get(target) or next(n for n in named if n is not None)
+        self.sent.setdefault(source, []).append(name)
+        self.received.setdefault(target, name)
+
+    def _event_message(self, xml_id: str) -> list[str | None]:
+        """The name of the message an event or task refers to, if any."""
+        element = self.elements.get(xml_id)
+        if element is None:
+            return []
+        references = [element.get("messageRef")] + [
+            d.get("messageRef") for d in _children(element, "messageEventDefinition")
+        ]
+        return [self.definitions.get(r or "") for r in references if r]
 
     def _refuse_element(self, element: ET.Element, local: str) -> None:
         xml_id = element.get("id", "")
-        why = REFUSED_WHY.get(local, "hrc does not map this BPMN element")
+        what = describe(local, xml_id or "(without id)", element.get("name"))
         self.fail(
-            f"The <{local}> {xml_id or '(without id)'} cannot be imported: {why}.",
+            f"The {what} cannot be imported: hrc does not map <{local}> here.",
             *([xml_id] if xml_id else []),
         )
 
@@ -351,31 +422,23 @@ class _Importer:
         process_xml_id = element.get("id", "")
         if not process_xml_id:
             self.fail("A <process> has no id; BPMN needs one on every process.")
-        process_id = self.hrc_ids.get(process_xml_id, process_xml_id)
-        nodes = self._flow_nodes(element)
-        flows = self._flows(element, nodes)
-        net = FlowNet(self.fresh, process_id, flows)
-        for node in nodes.values():
-            self._check_flows(node)
-        lanes = self._lanes(element, nodes, pool, process_id)
-        for node in nodes.values():
-            net.add(node, lanes.get(node.xml_id))
-        net.ends([n for n in nodes.values() if n.kind == "startEvent"], start=True)
-        net.ends([n for n in nodes.values() if n.kind == "endEvent"], start=False)
-        if not any(n.kind == "startEvent" for n in nodes.values()):
-            self.fail(
-                f"Process {process_xml_id} has no start event; hrc maps a start event to the "
-                "net's source place.",
-                process_xml_id,
-            )
-        if not any(n.kind == "endEvent" for n in nodes.values()):
-            self.fail(
-                f"Process {process_xml_id} has no end event; hrc maps an end event to the net's "
-                "sink place.",
-                process_xml_id,
-            )
+        process_id = self.hrc_id(process_xml_id)
+        graph = ProcessReader(self, element, process_id, self.called).read()
+        net = FlowNet(self.fresh, process_id, graph.flows)
+        self._scope_places(graph, net)
+        performers = self._lanes(element, graph, pool, process_id)
+        for node in graph.nodes:
+            net.add(node, performers.get(node.hrc_id))
+        for scope, call_id, pattern in graph.inlined:
+            performers.update(self._inline(net, scope, call_id, pattern))
+        for scope_id, scope in graph.scopes.items():
+            net.ends(graph.starts.get(scope_id, []), scope, start=True)
+            net.ends(graph.ends.get(scope_id, []), scope, start=False)
+        net.finish()
+        for key, value in graph.data.items():
+            self.data.setdefault(key, value)
         data: Json = {"id": process_id, "workpiece": _workpiece(element, pool, process_id)}
-        data["actors"] = list(dict.fromkeys(lanes.values()))
+        data["actors"] = list(dict.fromkeys(performers.values()))
         if element.get("name"):
             data["name"] = element.get("name")
         data.update(
@@ -390,129 +453,155 @@ class _Importer:
         data["arcs"] = net.arcs
         return data
 
-    def _flow_nodes(self, process: ET.Element) -> dict[str, FlowNode]:
-        nodes: dict[str, FlowNode] = {}
-        process_id = process.get("id", "")
-        for child in process:
-            local = _bpmn(child)
-            if local is None or local in PROCESS_IGNORED:
+    def _scope_places(self, graph: ProcessGraph, net: FlowNet) -> None:
+        """Every scope's source, sink, scope and armed places.
+
+        The process' source and sink are named after its start or end event when
+        it has one (as BPMN export writes them); its scope place belongs to the
+        enclosing scope, so what cancels inside a scope never empties it.
+        """
+        root = graph.root
+        for kind, events in (("start", graph.starts), ("end", graph.ends)):
+            found = events.get(root.hrc_id, [])
+            if len(found) == 1:
+                event = found[0]
+                named = {"name": event.name} if event.name else {}
+                extra = {k: v for k, v in event.extra.items() if k != "id"}
+                place = net.place(event.hrc_id, root, **named, **extra)
+            else:
+                place = net.place(self.fresh(f"{root.hrc_id}_{kind}"), root)
+            if kind == "start":
+                root.source = place
+            else:
+                root.sink = place
+            if not found:
+                what = describe("process", root.hrc_id, None)
+                self.fail(f"The {what} has no flow nodes to {kind} at.", root.hrc_id)
+        if root.place is not None:
+            net.place(root.place, root)
+        for scope in graph.scopes.values():
+            if scope is root:
                 continue
-            if local not in FLOW_NODE_KINDS:
-                self._refuse_element(child, local)
-                continue
-            xml_id = child.get("id", "")
-            if not xml_id:
-                self.fail(f"A <{local}> in process {process_id} has no id.", process_id)
-                continue
-            node = FlowNode(
-                local,
-                xml_id,
-                self.hrc_ids.get(xml_id, xml_id),
-                child.get("name") or None,
-                {},
-                child.get("default"),
+            for place in (scope.source, scope.sink, *scope.armed):
+                net.place(place, scope)
+            net.place(scope.place or "", scope.parent or root)
+
+    def _inline(self, net: FlowNet, scope: Scope, call_id: str, pattern: Pattern) -> dict[str, str]:
+        """Copies a called pattern's net into the call activity's scope; returns task -> actor.
+
+        Its source and sink places become the scope's; every other id and its
+        actors get the call activity's id in front, and its constraints come along.
+        """
+        process = pattern.processes[0]
+        ids: dict[str, str] = {}
+        ids.update(dict.fromkeys(process.source_places()[:1], scope.source))
+        ids.update(dict.fromkeys(process.sink_places()[:1], scope.sink))
+        for element_id in [p.id for p in process.places] + [t.id for t in process.transitions]:
+            ids.setdefault(element_id, self.fresh(f"{call_id}.{element_id}"))
+        actors: dict[str, str] = {}
+        for actor in pattern.actors:
+            actors[actor.id] = self.fresh(f"{call_id}.{actor.id}")
+            self.actors[actors[actor.id]] = {
+                "id": actors[actor.id],
+                "type": actor.type,
+                **actor.extra,
+            }
+        for place in process.places:
+            net.place(ids[place.id], scope, **place.extra)
+        performers: dict[str, str] = {}
+        for transition in process.transitions:
+            performer = actors.get(transition.performer or "")
+            net.transition(
+                ids[transition.id],
+                scope,
+                performer=performer,
+                label=transition.label,
+                extra=dict(transition.extra),
             )
-            node.extra = self._extra(child, node.describe())
-            self._check_contents(child, node)
-            nodes[xml_id] = node
-        return nodes
+            if performer is not None:
+                performers[ids[transition.id]] = performer
+        for source, target in process.arcs:
+            net.arc(ids[source], ids[target])
+        for constraint in pattern.constraints:
+            if constraint.source in ids and constraint.target in ids:
+                self.constraints.append(
+                    {
+                        "from": ids[constraint.source],
+                        "to": ids[constraint.target],
+                        "type": constraint.type,
+                        **constraint.extra,
+                    }
+                )
+        return performers
 
-    def _flows(self, process: ET.Element, nodes: dict[str, FlowNode]) -> list[Flow]:
-        flows = []
-        for element in _children(process, "sequenceFlow"):
-            xml_id = element.get("id", "")
-            if not xml_id:
-                self.fail(f"A <sequenceFlow> in process {process.get('id')} has no id.")
-                continue
-            ends = [nodes.get(element.get(ref, "")) for ref in ("sourceRef", "targetRef")]
-            source, target = ends
-            if source is None or target is None:
-                missing = [
-                    element.get(ref) or "(nothing)"
-                    for ref, end in zip(("sourceRef", "targetRef"), ends, strict=True)
-                    if end is None
-                ]
-                self.fail(
-                    f"Sequence flow {xml_id} names {', '.join(missing)}, which is no flow node of "
-                    f"process {process.get('id')}.",
-                    xml_id,
-                )
-                continue
-            extra = self._extra(element, f"sequence flow {xml_id}")
-            if element.get("name") and "name" not in extra:
-                extra = {"name": element.get("name"), **extra}
-            extra.pop("id", None)
-            condition = next(iter(_children(element, "conditionExpression")), None)
-            text = None if condition is None else (condition.text or "").strip() or None
-            flow = Flow(xml_id, self.hrc_ids.get(xml_id, xml_id), source, target, extra, text)
-            if condition is not None and source.kind != "exclusiveGateway":
-                self.fail(
-                    f"Sequence flow {xml_id} has a condition but leaves {source.describe()}; "
-                    "conditions are mapped only on flows out of an exclusive gateway.",
-                    xml_id,
-                )
-            source.outgoing.append(flow)
-            target.incoming.append(flow)
-            flows.append(flow)
-        return flows
+    # What the process reader asks.
 
-    def _check_contents(self, element: ET.Element, node: FlowNode) -> None:
-        """Refuses what the mapping does not cover inside a flow node."""
-        for child in element:
-            local = _bpmn(child) or ""
-            if local.endswith("EventDefinition") or local == "eventDefinitionRef":
-                self.fail(
-                    f"The {node.describe()} has a {local}; only none events (without a "
-                    "definition) are mapped.",
-                    node.xml_id,
-                )
-            elif local in ("standardLoopCharacteristics", "multiInstanceLoopCharacteristics"):
-                self.fail(
-                    f"The {node.describe()} has {local}; loop and multi-instance tasks are not "
-                    "mapped: draw the loop with an exclusive gateway.",
-                    node.xml_id,
-                )
+    def hrc_id(self, xml_id: str) -> str:
+        return self.hrc_ids.get(xml_id, xml_id)
 
-    def _check_flows(self, node: FlowNode) -> None:
-        if node.kind == "startEvent" and node.incoming:
-            self.fail(f"Start event {node.xml_id} has an incoming sequence flow.", node.xml_id)
-        if node.kind == "endEvent" and node.outgoing:
-            self.fail(f"End event {node.xml_id} has an outgoing sequence flow.", node.xml_id)
+    def extra(self, element: ET.Element, where: str) -> Json:
+        return self._extra(element, where)
+
+    def process_element(self, xml_id: str) -> ET.Element | None:
+        return self.processes.get(xml_id)
+
+    def global_task(self, xml_id: str) -> ET.Element | None:
+        return self.global_tasks.get(xml_id)
+
+    def definition_name(self, reference: str | None) -> str | None:
+        return self.definitions.get(reference or "")
+
+    def message_in(self, xml_id: str) -> str | None:
+        return self.received.get(xml_id)
+
+    def messages_out(self, xml_id: str) -> list[str]:
+        return self.sent.get(xml_id, [])
+
+    def signal_thrown(self, name: str) -> bool:
+        return name in self.signals_thrown
+
+    def event_definition(self, xml_id: str) -> ET.Element | None:
+        element = self.elements.get(xml_id)
+        local = _bpmn(element) if element is not None else None
+        return element if local and local.endswith("EventDefinition") else None
 
     # Lanes and actors.
 
     def _lanes(
         self,
         process: ET.Element,
-        nodes: dict[str, FlowNode],
+        graph: ProcessGraph,
         pool: ET.Element | None,
         process_id: str,
     ) -> dict[str, str]:
-        """XML id of each task -> its actor's id; adds the actors that perform tasks."""
+        """hrc id of each task -> its actor's id; adds the actors that perform tasks.
+
+        A task inside a sub-process or called process is in the lane of its
+        outermost activity, unless its own lanes say otherwise; a task in no
+        lane is the pool's.
+        """
         lane_of: dict[str, ET.Element] = {}
-        lanes = list(self._all_lanes(process))
+        # A called process' own lanes count for the tasks inlined from it.
+        lanes = list(self._all_lanes(process)) + [
+            lane
+            for other in self.processes.values()
+            if other is not process
+            for lane in self._all_lanes(other)
+        ]
         for lane in lanes:  # outer lanes first, so an inner lane overrides
             for reference in _children(lane, "flowNodeRef"):
                 lane_of[(reference.text or "").strip()] = lane
-        tasks = [node for node in nodes.values() if node.kind in TASK_KINDS]
         performers: dict[str, str] = {}
         default: str | None = None
-        for task in tasks:
-            if lanes:
-                home = lane_of.get(task.xml_id)
-                if home is None:
-                    self.fail(
-                        f"Task {task.xml_id} is in no lane of process {process.get('id')}; "
-                        "put it in the lane of the actor who performs it.",
-                        task.xml_id,
-                    )
-                    continue
-                performers[task.xml_id] = self._actor(home, f"lane {home.get('id')}")
+        for task_id, lookups in graph.tasks.items():
+            home = next((lane_of[i] for i in lookups if i in lane_of), None)
+            if home is not None:
+                performers[task_id] = self._actor(home, f"lane {home.get('id')}")
             elif pool is not None:
-                performers[task.xml_id] = self._actor(pool, f"pool {pool.get('id')}")
+                performers[task_id] = self._actor(pool, f"pool {pool.get('id')}")
             else:
                 default = default or self._default_actor(process_id, process.get("name"))
-                performers[task.xml_id] = default
+                performers[task_id] = default
         return performers
 
     def _all_lanes(self, container: ET.Element) -> Iterator[ET.Element]:
