@@ -1,0 +1,176 @@
+"""BPMN export that other tools read: OMG's XSD accepts it, and hrc's importer gives it back.
+
+The schema is OMG's BPMN 2.0 XSD (BPMN20.xsd with Semantic.xsd, BPMNDI.xsd,
+DC.xsd and DI.xsd), as SpiffWorkflow ships it. The exports checked are the
+example library, the use cases, the shared examples beside the checkout, and a
+model with the keys of timers, cancellation, messages between pools and
+guards. Round trip: each task, and each silent transition that carries
+configuration (timer, cancels, message, send, guard, rewrite), comes back with
+its id, performer, label and keys; what `cancels` names is still there.
+"""
+
+import json
+from functools import cache
+from importlib.resources import files
+from pathlib import Path
+from typing import Any
+
+import pytest
+from lxml import etree
+
+from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
+from hrc.engine.bpmn_export import pattern_to_bpmn
+from hrc.engine.document import read_pattern
+from hrc.engine.model import Pattern, Process
+from tests.engine.builders import EXAMPLES, document, process
+
+ROOT = Path(__file__).resolve().parents[2]
+# Beside the checkout in CI (../shared); a worktree sits one level deeper.
+SHARED = next((p / "shared" for p in ROOT.parents if (p / "shared").is_dir()), ROOT / "shared")
+LIBRARY = sorted(EXAMPLES.rglob("*.json")) + sorted((SHARED / "examples").glob("*.json"))
+
+
+def _name(path: Path) -> str:
+    return f"{path.parent.name}/{path.stem}"
+
+
+def configured() -> dict[str, Any]:
+    """Two pools: the operator's load sends a message the cobot's process waits for, against a timer.
+
+    The operator's inspection loops back on a guard, and a watchdog timer cancels
+    the inspection and its places; a time and a space constraint tie the pools.
+    """
+    operator = process(
+        "cell_operator",
+        "ps load pa inspect pb x_ok pe",
+        "pb x_rework pa",
+        "load pw x_watchdog pe",
+        performers={"load": "o1", "inspect": "o1"},
+        workpiece="part",
+    )
+    cobot = process(
+        "cell_cobot",
+        "pc0 x_loaded pc1 grasp pc2 drop pc3",
+        "pc0 x_give_up pc3",
+        performers={"grasp": "c1", "drop": "c1"},
+        workpiece="part",
+    )
+    operator["arcs"].append(["pw", "x_ok"])  # the inspection ends the watch
+    keys = {
+        "load": {"send": {"name": "loaded", "correlation": {"case": "=case.id"}}},
+        "x_ok": {"guard": "data.ok"},
+        "x_rework": {"guard": "not data.ok", "rewrite": "the original said ${!ok} in JUEL"},
+        "x_watchdog": {"timer": "PT10M", "cancels": ["inspect", "pa", "pb"]},
+        "x_loaded": {"message": {"name": "loaded", "correlation": {"case": "case.id"}}},
+        "x_give_up": {"timer": "PT5M", "label": "no part"},
+    }
+    for net in (operator, cobot):
+        for transition in net["transitions"]:
+            transition.update(keys.get(transition["id"], {}))
+    return document(
+        operator, cobot, constraints=[("load", "grasp", "time"), ("drop", "inspect", "space")]
+    )
+
+
+def _library() -> list[Any]:
+    examples = [pytest.param(json.loads(p.read_text()), id=_name(p)) for p in LIBRARY]
+    return [*examples, pytest.param(configured(), id="timers-messages-guards")]
+
+
+# The schema ------------------------------------------------------------------------------
+
+
+@cache
+def bpmn_schema() -> etree.XMLSchema:
+    root = files("SpiffWorkflow.bpmn.parser") / "schema" / "BPMN20.xsd"
+    # Parsed from its path, so the xsd:include and xsd:import beside it resolve.
+    return etree.XMLSchema(etree.parse(str(root)))
+
+
+def schema_errors(text: str) -> list[str]:
+    schema = bpmn_schema()
+    if schema.validate(etree.fromstring(text.encode())):
+        return []
+    return [f"line {e.line}: {e.message}" for e in schema.error_log]
+
+
+@pytest.mark.parametrize("data", _library())
+def test_every_export_validates_against_the_bpmn_schema(data: dict[str, Any]) -> None:
+    assert schema_errors(pattern_to_bpmn(read_pattern(data))) == []
+
+
+def test_the_shared_examples_are_found() -> None:
+    assert len(LIBRARY) > len(list(EXAMPLES.glob("*.json")))
+
+
+def test_the_schema_refuses_what_bpmn_does_not_allow() -> None:
+    """Element order matters to the XSD: a flow node after the process' artifacts is refused."""
+    root = etree.fromstring(pattern_to_bpmn(read_pattern(configured())).encode())
+    body = root.find(f"{{{BPMN_NAMESPACE}}}process")
+    assert body is not None
+    association = body.find(f"{{{BPMN_NAMESPACE}}}association")
+    task = body.find(f"{{{BPMN_NAMESPACE}}}task")
+    assert association is not None
+    assert task is not None
+    body.remove(task)
+    body.append(task)
+    errors = schema_errors(etree.tostring(root, encoding="unicode"))
+    assert errors
+    assert "task" in errors[0]
+
+
+# Round trip ------------------------------------------------------------------------------
+
+
+def _keys(extra: Any) -> dict[str, Any]:
+    return {key: value for key, value in extra.items() if key != "layout"}
+
+
+def _node_kinds(net: Process) -> dict[str, str]:
+    return {
+        **{place.id: "place" for place in net.places},
+        **{transition.id: "transition" for transition in net.transitions},
+    }
+
+
+def assert_configuration_comes_back(pattern: Pattern, back: Pattern) -> None:
+    for original, copy in zip(pattern.processes, back.processes, strict=True):
+        copied = {t.id: t for t in copy.transitions}
+        for transition in original.transitions:
+            if not (transition.is_task or _keys(transition.extra)):
+                continue  # plain routing: BPMN's gateways and events bring their own
+            twin = copied.get(transition.id)
+            assert twin is not None, f"{transition.id} did not come back"
+            assert (twin.performer, twin.label) == (transition.performer, transition.label)
+            assert _keys(twin.extra) == _keys(transition.extra), transition.id
+        kinds, copied_kinds = _node_kinds(original), _node_kinds(copy)
+        for transition in original.transitions:
+            for named in transition.extra.get("cancels", []):
+                assert copied_kinds.get(named) == kinds[named], f"{transition.id} cancels {named}"
+
+
+@pytest.mark.parametrize("data", _library())
+def test_every_export_imports_back_with_its_configuration(data: dict[str, Any]) -> None:
+    pattern = read_pattern(data)
+    back = bpmn_to_pattern(pattern_to_bpmn(pattern))
+    assert (back.name, back.declared_pattern) == (pattern.name, pattern.declared_pattern)
+    assert _keys(back.extra) == _keys(pattern.extra)
+    assert back.constraints == pattern.constraints
+    assert [(p.id, p.workpiece, _keys(p.extra)) for p in back.processes] == [
+        (p.id, p.workpiece, _keys(p.extra)) for p in pattern.processes
+    ]
+    assert_configuration_comes_back(pattern, back)
+
+
+def test_the_configured_model_keeps_its_timers_messages_and_cancellation() -> None:
+    back = bpmn_to_pattern(pattern_to_bpmn(read_pattern(configured())))
+    watchdog, loaded = back.transition("x_watchdog"), back.transition("x_loaded")
+    assert watchdog is not None
+    assert loaded is not None
+    assert watchdog.extra["timer"] == "PT10M"
+    assert watchdog.extra["cancels"] == ["inspect", "pa", "pb"]
+    assert loaded.extra["message"]["name"] == "loaded"
+    assert [(c.source, c.target, c.type) for c in back.constraints] == [
+        ("load", "grasp", "time"),
+        ("drop", "inspect", "space"),
+    ]
