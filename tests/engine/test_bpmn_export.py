@@ -20,6 +20,7 @@ from lxml import etree
 
 from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
 from hrc.engine.bpmn_export import pattern_to_bpmn
+from hrc.engine.check import check_pattern
 from hrc.engine.document import read_pattern
 from hrc.engine.model import Pattern, Process
 from tests.engine.builders import EXAMPLES, document, process
@@ -160,6 +161,18 @@ def test_every_export_imports_back_with_its_configuration(data: dict[str, Any]) 
         (p.id, p.workpiece, _keys(p.extra)) for p in pattern.processes
     ]
     assert_configuration_comes_back(pattern, back)
+
+
+@pytest.mark.parametrize("path", LIBRARY, ids=_name)
+def test_every_example_imports_back_with_its_verdict(path: Path) -> None:
+    pattern = read_pattern(json.loads(path.read_text()))
+    before, after = check_pattern(pattern), check_pattern(bpmn_to_pattern(pattern_to_bpmn(pattern)))
+    assert (after.valid, after.sound, after.patterns) == (
+        before.valid,
+        before.sound,
+        before.patterns,
+    )
+    assert sorted(e.code for e in after.errors) == sorted(e.code for e in before.errors)
 
 
 def test_the_configured_model_keeps_its_timers_messages_and_cancellation() -> None:
