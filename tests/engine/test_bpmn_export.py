@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import HealthCheck, given, settings
 from lxml import etree
 
 from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
@@ -24,6 +25,7 @@ from hrc.engine.check import check_pattern
 from hrc.engine.document import read_pattern
 from hrc.engine.model import Pattern, Process
 from tests.engine.builders import EXAMPLES, document, process
+from tests.engine.strategies import decorated, patterns
 
 ROOT = Path(__file__).resolve().parents[2]
 # Beside the checkout in CI (../shared); a worktree sits one level deeper.
@@ -100,8 +102,14 @@ def test_every_export_validates_against_the_bpmn_schema(data: dict[str, Any]) ->
     assert schema_errors(pattern_to_bpmn(read_pattern(data))) == []
 
 
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(patterns(mutate=False) | decorated())
+def test_generated_exports_validate_against_the_bpmn_schema(data: dict[str, Any]) -> None:
+    assert schema_errors(pattern_to_bpmn(read_pattern(data))) == []
+
+
 def test_the_shared_examples_are_found() -> None:
-    assert len(LIBRARY) > len(list(EXAMPLES.glob("*.json")))
+    assert sorted((SHARED / "examples").glob("*.json"))
 
 
 def test_the_schema_refuses_what_bpmn_does_not_allow() -> None:
