@@ -34,6 +34,7 @@ import xml.etree.ElementTree as ET
 from collections import defaultdict
 from collections.abc import Mapping
 from dataclasses import dataclass
+from operator import itemgetter
 from typing import Any
 
 from hrc.engine.bpmn import (
@@ -166,6 +167,28 @@ class _Shape:
         return x - w / 2, y - h / 2, w, h
 
 
+@dataclass
+class _Stack:
+    """Where one process' pool is drawn: its lanes' bands of the layout, stacked from `top`."""
+
+    moves: list[tuple[float, float, float]]
+    """(top in the layout, top in the pool, height) of each of its bands."""
+    lanes: dict[str | None, tuple[float, float]]
+    """Band key (an actor, or None) -> (top, height) of its lane in the pool."""
+    top: float
+    bottom: float
+
+    def y(self, y: float) -> float:
+        """A layout y moved with the band it lies in (the nearest band when it lies in none)."""
+
+        def distance(move: tuple[float, float, float]) -> float:
+            start, _, height = move
+            return max(start - y, y - (start + height), 0.0)
+
+        start, top, height = min(self.moves, key=distance)
+        return min(max(y - start + top, top), top + height)
+
+
 class _Writer:
     def __init__(self, pattern: Pattern) -> None:
         self.pattern = pattern
@@ -185,6 +208,39 @@ class _Writer:
             self.bands.setdefault(
                 actor if isinstance(actor, str) else None, (float(lane["y"]), float(lane["height"]))
             )
+        self.stacks: dict[str, _Stack] = {}
+        bottom = 0.0
+        for process in pattern.processes:
+            stack = self._stack(process, bottom)
+            self.stacks[process.id] = stack
+            bottom = stack.bottom
+
+    def band_key(self, actor_id: str) -> str | None:
+        """The layout's lane of an actor; a performer that is no actor is in the lane of None."""
+        return actor_id if self.pattern.actor(actor_id) is not None else None
+
+    def _stack(self, process: Process, top: float) -> "_Stack":
+        """The process' pool from `top` down: the layout's bands of its actors, one under another.
+
+        The layout shares an actor's band among the processes it works in; BPMN draws
+        each pool apart, so a process' lanes are moved together under the pool above.
+        """
+        keys = dict.fromkeys(self.band_key(actor) for actor in _lane_actors(process))
+        bands = sorted(
+            ((self.bands[key], key) for key in keys if key in self.bands), key=itemgetter(0)
+        )
+        if not bands:
+            ys = [
+                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
+            ] or [0.0]
+            span = (min(ys) - TASK_HEIGHT, max(ys) - min(ys) + 2 * TASK_HEIGHT)
+            return _Stack([(span[0], top, span[1])], {}, top, top + span[1])
+        stack = _Stack([], {}, top, top)
+        for (layout_top, height), key in bands:
+            stack.moves.append((layout_top, stack.bottom, height))
+            stack.lanes[key] = (stack.bottom, height)
+            stack.bottom += height
+        return stack
 
     def text(self) -> str:
         pattern = self.pattern
@@ -289,8 +345,10 @@ class _Writer:
             bpmnElement=plane_of,
         )
         for pool, process in pools:
-            top, bottom = self._pool_band(process)
-            self._shape(plane, pool, (0.0, top, self.width, bottom - top), horizontal=True)
+            stack = self.stacks[process.id]
+            self._shape(
+                plane, pool, (0.0, stack.top, self.width, stack.bottom - stack.top), horizontal=True
+            )
         for lane, bounds in self.pool_lanes:
             self._shape(plane, lane, bounds, horizontal=True)
         by_element = {shape.element: shape for shape in self.shapes}
@@ -305,15 +363,6 @@ class _Writer:
             )
             for x, y in _waypoints(by_element[source], by_element[target]):
                 ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
-
-    def _pool_band(self, process: Process) -> tuple[float, float]:
-        bands = [self.bands[actor] for actor in _lane_actors(process) if actor in self.bands]
-        if not bands:
-            ys = [
-                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
-            ] or [0.0]
-            return min(ys) - TASK_HEIGHT, max(ys) + TASK_HEIGHT
-        return min(top for top, _ in bands), max(top + height for top, height in bands)
 
     def _shape(
         self,
@@ -355,6 +404,7 @@ class _ProcessWriter:
         self.writer = writer
         self.ids = writer.ids
         self.process = process
+        self.stack = writer.stacks[process.id]
         self.element = element
         self.inputs: dict[str, list[str]] = defaultdict(list)
         self.outputs: dict[str, list[str]] = defaultdict(list)
@@ -417,7 +467,7 @@ class _ProcessWriter:
         if actor is not None:
             lane.set(_tag("actorType", HRC_NAMESPACE), actor.type)
         _add_extra(lane, extra)
-        band = self.writer.bands.get(actor_id if actor is not None else None)
+        band = self.stack.lanes.get(self.writer.band_key(actor_id))
         if band is not None:
             left = POOL_HEADER_WIDTH
             self.writer.pool_lanes.append(
@@ -552,7 +602,9 @@ class _ProcessWriter:
         return flow
 
     def _shape(self, element: str, centre: tuple[float, float], size: tuple[float, float]) -> None:
-        self.writer.shapes.append(_Shape(element, centre, size))
+        """A shape at its layout position, moved into the process' pool."""
+        x, y = centre
+        self.writer.shapes.append(_Shape(element, (x, self.stack.y(y)), size))
 
 
 def _add_extra(element: ET.Element, data: Json) -> None:

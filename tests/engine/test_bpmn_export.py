@@ -9,6 +9,7 @@ configuration (timer, cancels, message, send, guard, rewrite), comes back with
 its id, performer, label and keys; what `cancels` names is still there.
 """
 
+import itertools
 import json
 from functools import cache
 from importlib.resources import files
@@ -195,3 +196,51 @@ def test_the_configured_model_keeps_its_timers_messages_and_cancellation() -> No
         ("load", "grasp", "time"),
         ("drop", "inspect", "space"),
     ]
+
+
+# The diagram -----------------------------------------------------------------------------
+
+DI = "{http://www.omg.org/spec/BPMN/20100524/DI}"
+DC = "{http://www.omg.org/spec/DD/20100524/DC}"
+Box = tuple[float, float, float, float]
+
+
+def _exported(data: dict[str, Any]) -> Any:
+    return etree.fromstring(pattern_to_bpmn(read_pattern(data)).encode())
+
+
+def _boxes(root: Any) -> dict[str, Box]:
+    """bpmnElement -> (left, top, right, bottom) of its shape."""
+    boxes = {}
+    for shape in root.iter(f"{DI}BPMNShape"):
+        bounds = shape.find(f"{DC}Bounds")
+        x, y, w, h = (float(bounds.get(k)) for k in ("x", "y", "width", "height"))
+        boxes[shape.get("bpmnElement")] = (x, y, x + w, y + h)
+    return boxes
+
+
+def _inside(box: Box, outer: Box) -> bool:
+    centre_y = (box[1] + box[3]) / 2
+    return outer[1] <= centre_y <= outer[3]
+
+
+@pytest.mark.parametrize("data", _library())
+def test_each_pool_is_drawn_apart_holding_its_lanes_and_nodes(data: dict[str, Any]) -> None:
+    """Processes that share an actor share its lane in the editor; in BPMN each pool has its own."""
+    root = _exported(data)
+    boxes = _boxes(root)
+    pools = {
+        p.get("processRef"): boxes[p.get("id")]
+        for p in root.iter(f"{{{BPMN_NAMESPACE}}}participant")
+    }
+    ordered = sorted(pools.values(), key=lambda box: box[1])
+    assert all(upper[3] <= lower[1] for upper, lower in itertools.pairwise(ordered))
+    for net in root.iter(f"{{{BPMN_NAMESPACE}}}process"):
+        pool = pools[net.get("id")]
+        for lane in net.iter(f"{{{BPMN_NAMESPACE}}}lane"):
+            assert pool[1] <= boxes[lane.get("id")][1] < boxes[lane.get("id")][3] <= pool[3]
+            for reference in lane.iter(f"{{{BPMN_NAMESPACE}}}flowNodeRef"):
+                assert _inside(boxes[reference.text], boxes[lane.get("id")]), reference.text
+        for node in net:
+            if node.get("id") in boxes:
+                assert _inside(boxes[node.get("id")], pool), node.get("id")
