@@ -244,3 +244,57 @@ def test_each_pool_is_drawn_apart_holding_its_lanes_and_nodes(data: dict[str, An
         for node in net:
             if node.get("id") in boxes:
                 assert _inside(boxes[node.get("id")], pool), node.get("id")
+
+
+# What other tools see --------------------------------------------------------------------
+
+
+def _one(root: Any, path: str) -> Any:
+    found = root.xpath(path, namespaces={"bpmn": BPMN_NAMESPACE})
+    assert len(found) == 1, path
+    return found[0]
+
+
+def test_a_timer_is_an_intermediate_timer_event_with_its_duration() -> None:
+    root = _exported(configured())
+    duration = _one(root, "//bpmn:intermediateCatchEvent[@id='x_give_up']//bpmn:timeDuration")
+    assert duration.text == "PT5M"
+    assert _one(root, "//bpmn:intermediateCatchEvent[@id='x_give_up']").get("name") == "no part"
+
+
+def test_a_message_between_pools_is_a_message_flow_to_a_message_catch_event() -> None:
+    root = _exported(configured())
+    message = _one(root, "/bpmn:definitions/bpmn:message[@name='loaded']")
+    catch = _one(root, "//bpmn:intermediateCatchEvent[@id='x_loaded']/bpmn:messageEventDefinition")
+    flow = _one(root, "//bpmn:collaboration/bpmn:messageFlow")
+    assert catch.get("messageRef") == message.get("id") == flow.get("messageRef")
+    assert (flow.get("sourceRef"), flow.get("targetRef")) == ("load", "x_loaded")
+
+
+def test_a_choice_between_a_message_and_a_timer_is_an_event_based_gateway() -> None:
+    root = _exported(configured())
+    gateway = _one(root, "//bpmn:eventBasedGateway")
+    targets = root.xpath(
+        f"//bpmn:sequenceFlow[@sourceRef='{gateway.get('id')}']/@targetRef",
+        namespaces={"bpmn": BPMN_NAMESPACE},
+    )
+    assert sorted(targets) == ["x_give_up", "x_loaded"]
+    # The operator's watchdog competes with a plain step: a data-based choice, as before.
+    assert _one(root, "//bpmn:exclusiveGateway[@id='pw_split']") is not None
+
+
+def test_a_silent_send_is_a_message_throw_event() -> None:
+    data = configured()
+    load = data["processes"][0]["transitions"][0]
+    send = load.pop("send")
+    data["processes"][0]["transitions"].append({"id": "x_tell", "send": send})
+    data["processes"][0]["arcs"] = [
+        ["x_tell", "pa"] if arc == ["load", "pa"] else arc for arc in data["processes"][0]["arcs"]
+    ] + [["load", "p_told"], ["p_told", "x_tell"]]
+    data["processes"][0]["places"].append({"id": "p_told"})
+    root = _exported(data)
+    throw = _one(root, "//bpmn:intermediateThrowEvent[@id='x_tell']/bpmn:messageEventDefinition")
+    flow = _one(root, "//bpmn:collaboration/bpmn:messageFlow")
+    assert (flow.get("sourceRef"), flow.get("targetRef")) == ("x_tell", "x_loaded")
+    assert throw.get("messageRef") == flow.get("messageRef")
+    assert schema_errors(etree.tostring(root, encoding="unicode")) == []
