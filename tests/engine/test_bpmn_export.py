@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from lxml import etree
 
 from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
@@ -298,3 +299,30 @@ def test_a_silent_send_is_a_message_throw_event() -> None:
     assert (flow.get("sourceRef"), flow.get("targetRef")) == ("x_tell", "x_loaded")
     assert throw.get("messageRef") == flow.get("messageRef")
     assert schema_errors(etree.tostring(root, encoding="unicode")) == []
+
+
+@st.composite
+def with_events(draw: st.DrawFn) -> dict[str, Any]:
+    """A generated pattern whose silent steps wait for timers or messages, or send one."""
+    data = draw(patterns(mutate=False))
+    keys = st.sampled_from(
+        [
+            {},
+            {"timer": "PT1M"},
+            {"message": {"name": "m", "correlation": {"case": "case.id"}}},
+            {"send": {"name": "m"}},
+        ]
+    )
+    for transition in data["processes"][0]["transitions"]:
+        if "performer" not in transition:
+            transition.update(draw(keys))
+    return data
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(with_events())
+def test_generated_exports_with_events_validate_and_import_back(data: dict[str, Any]) -> None:
+    pattern = read_pattern(data)
+    text = pattern_to_bpmn(pattern)
+    assert schema_errors(text) == []
+    assert_configuration_comes_back(pattern, bpmn_to_pattern(text))
