@@ -8,15 +8,21 @@ engineer drew it. The net becomes BPMN the reverse way of `bpmn.py`'s import:
 | --- | --- |
 | task (a transition with a performer) | a task in its performer's lane (a `userTask`, ... when the transition's `bpmn` key says so); a task with several input places gets a parallel gateway `<task>_join` before it |
 | silent transition | a parallel gateway (it consumes all its inputs and produces all its outputs) |
-| source place | a start event (followed by an exclusive gateway `<place>_split` when several transitions compete for its token) |
+| silent transition with a `timer` | an intermediate catch event with a timerEventDefinition (its timeDuration); several inputs get a parallel gateway `<id>_join` before it |
+| silent transition with a `message` | an intermediate catch event with a messageEventDefinition, referring to the file's `<message>` of that name |
+| silent transition with a `send` (and no `message`) | an intermediate throw event with a messageEventDefinition |
+| a task or silent transition with a `send`, and a catch event of that message in another process | a message flow from the one to the other, between their pools |
+| source place | a start event (followed by an exclusive gateway `<place>_split` when several transitions compete for its token; an event-based gateway when each of them is a catch event) |
 | sink place | an end event, reached by a flow from each transition that marks it |
 | any other place with one input and one output transition | a sequence flow |
-| a place with several inputs or outputs | an exclusive gateway (a merge, a choice, or both) between sequence flows |
+| a place with several inputs or outputs | an exclusive gateway (a merge, a choice, or both) between sequence flows; a choice between catch events only is an event-based gateway (BPMN's deferred choice) |
 | constraint | an association between the two tasks with `hrc:constraint="time"` (or space, func) |
 
 What BPMN cannot say travels in `<hrc:extra>` (see `bpmn.py`): task
 configuration, guards, initial tokens, workpieces, the declared pattern, and
-any id XML cannot hold as written; `bpmn.bpmn_to_pattern` reads it back.
+any id XML cannot hold as written; `bpmn.bpmn_to_pattern` reads it back. The
+keys an event shows (`timer`, `message`, `send`) stay in it too, with their
+correlation and `cancels`, so the import gives them back exactly.
 Positions come from the document's `layout` (`layout.lay_out` when it has
 none): tasks, gateways and events at their nodes' centres, pools and lanes as
 the layout's lane bands.
@@ -34,6 +40,7 @@ import xml.etree.ElementTree as ET
 from collections import defaultdict
 from collections.abc import Mapping
 from dataclasses import dataclass
+from operator import itemgetter
 from typing import Any
 
 from hrc.engine.bpmn import (
@@ -52,12 +59,15 @@ from hrc.engine.rules import check_rules
 
 Json = dict[str, Any]
 
+XSI_NAMESPACE = "http://www.w3.org/2001/XMLSchema-instance"
+
 for _prefix, _uri in (
     ("bpmn", BPMN_NAMESPACE),
     ("bpmndi", BPMNDI_NAMESPACE),
     ("dc", DC_NAMESPACE),
     ("di", DI_NAMESPACE),
     ("hrc", HRC_NAMESPACE),
+    ("xsi", XSI_NAMESPACE),
 ):
     ET.register_namespace(_prefix, _uri)
 
@@ -166,6 +176,28 @@ class _Shape:
         return x - w / 2, y - h / 2, w, h
 
 
+@dataclass
+class _Stack:
+    """Where one process' pool is drawn: its lanes' bands of the layout, stacked from `top`."""
+
+    moves: list[tuple[float, float, float]]
+    """(top in the layout, top in the pool, height) of each of its bands."""
+    lanes: dict[str | None, tuple[float, float]]
+    """Band key (an actor, or None) -> (top, height) of its lane in the pool."""
+    top: float
+    bottom: float
+
+    def y(self, y: float) -> float:
+        """A layout y moved with the band it lies in (the nearest band when it lies in none)."""
+
+        def distance(move: tuple[float, float, float]) -> float:
+            start, _, height = move
+            return max(start - y, y - (start + height), 0.0)
+
+        start, top, height = min(self.moves, key=distance)
+        return min(max(y - start + top, top), top + height)
+
+
 class _Writer:
     def __init__(self, pattern: Pattern) -> None:
         self.pattern = pattern
@@ -173,10 +205,17 @@ class _Writer:
         self.shapes: list[_Shape] = []
         self.edges: list[tuple[str, str, str]] = []
         """(flow or association id, source element, target element)."""
+        self.message_edges: list[tuple[str, str, str]] = []
+        """The same for message flows, which cross from pool to pool."""
         self.element_of: dict[str, str] = {}
         """hrc task id -> the XML id of its task (constraint ends)."""
         self.process_of_task: dict[str, ET.Element] = {}
         self.pool_lanes: list[tuple[str, tuple[float, float, float, float]]] = []
+        self.messages: dict[str, str] = {}
+        """Message name -> the XML id of its `<message>`."""
+        self.senders: list[tuple[str, str, str]] = []
+        self.catchers: list[tuple[str, str, str]] = []
+        """(process id, element, message name) of each sender and each message catch event."""
         layout = pattern.extra["layout"]
         self.width = float(layout["width"])
         self.bands: dict[str | None, tuple[float, float]] = {}
@@ -185,6 +224,39 @@ class _Writer:
             self.bands.setdefault(
                 actor if isinstance(actor, str) else None, (float(lane["y"]), float(lane["height"]))
             )
+        self.stacks: dict[str, _Stack] = {}
+        bottom = 0.0
+        for process in pattern.processes:
+            stack = self._stack(process, bottom)
+            self.stacks[process.id] = stack
+            bottom = stack.bottom
+
+    def band_key(self, actor_id: str) -> str | None:
+        """The layout's lane of an actor; a performer that is no actor is in the lane of None."""
+        return actor_id if self.pattern.actor(actor_id) is not None else None
+
+    def _stack(self, process: Process, top: float) -> "_Stack":
+        """The process' pool from `top` down: the layout's bands of its actors, one under another.
+
+        The layout shares an actor's band among the processes it works in; BPMN draws
+        each pool apart, so a process' lanes are moved together under the pool above.
+        """
+        keys = dict.fromkeys(self.band_key(actor) for actor in _lane_actors(process))
+        bands = sorted(
+            ((self.bands[key], key) for key in keys if key in self.bands), key=itemgetter(0)
+        )
+        if not bands:
+            ys = [
+                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
+            ] or [0.0]
+            span = (min(ys) - TASK_HEIGHT, max(ys) - min(ys) + 2 * TASK_HEIGHT)
+            return _Stack([(span[0], top, span[1])], {}, top, top + span[1])
+        stack = _Stack([], {}, top, top)
+        for (layout_top, height), key in bands:
+            stack.moves.append((layout_top, stack.bottom, height))
+            stack.lanes[key] = (stack.bottom, height)
+            stack.bottom += height
+        return stack
 
     def text(self) -> str:
         pattern = self.pattern
@@ -216,8 +288,13 @@ class _Writer:
             element, pool = self._process(process, collaboration)
             processes.append(element)
             pools.append((pool, process))
+        for name, message_id in self.messages.items():
+            message = ET.SubElement(root, _tag("message"), id=message_id)
+            if _is_text(name):
+                message.set("name", name)
         for element in processes:
             root.append(element)
+        self._message_flows(collaboration)
         self._constraints(collaboration)
         self._diagram(root, collaboration.get("id", ""), pools)
         ET.indent(root)
@@ -250,6 +327,29 @@ class _Writer:
         participant.set("name", element.get("name") or xml_id)
         _ProcessWriter(self, process, element).write()
         return element, pool
+
+    def message(self, name: str) -> str:
+        """The XML id of the `<message>` of this name, declared on first use."""
+        if name not in self.messages:
+            self.messages[name] = self.ids.fresh(f"message_{name}")
+        return self.messages[name]
+
+    def _message_flows(self, collaboration: ET.Element) -> None:
+        """A message flow from each sender to each catch event of its message in another pool."""
+        for sender_process, source, name in self.senders:
+            for catcher_process, target, wanted in self.catchers:
+                if wanted != name or catcher_process == sender_process:
+                    continue
+                flow_id = self.ids.fresh(f"message_flow_{source}_{target}")
+                ET.SubElement(
+                    collaboration,
+                    _tag("messageFlow"),
+                    id=flow_id,
+                    sourceRef=source,
+                    targetRef=target,
+                    messageRef=self.messages[name],
+                )
+                self.message_edges.append((flow_id, source, target))
 
     def _constraints(self, collaboration: ET.Element) -> None:
         for constraint in self.pattern.constraints:
@@ -289,8 +389,10 @@ class _Writer:
             bpmnElement=plane_of,
         )
         for pool, process in pools:
-            top, bottom = self._pool_band(process)
-            self._shape(plane, pool, (0.0, top, self.width, bottom - top), horizontal=True)
+            stack = self.stacks[process.id]
+            self._shape(
+                plane, pool, (0.0, stack.top, self.width, stack.bottom - stack.top), horizontal=True
+            )
         for lane, bounds in self.pool_lanes:
             self._shape(plane, lane, bounds, horizontal=True)
         by_element = {shape.element: shape for shape in self.shapes}
@@ -305,15 +407,15 @@ class _Writer:
             )
             for x, y in _waypoints(by_element[source], by_element[target]):
                 ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
-
-    def _pool_band(self, process: Process) -> tuple[float, float]:
-        bands = [self.bands[actor] for actor in _lane_actors(process) if actor in self.bands]
-        if not bands:
-            ys = [
-                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
-            ] or [0.0]
-            return min(ys) - TASK_HEIGHT, max(ys) + TASK_HEIGHT
-        return min(top for top, _ in bands), max(top + height for top, height in bands)
+        for edge_id, source, target in self.message_edges:
+            edge = ET.SubElement(
+                plane,
+                _tag("BPMNEdge", BPMNDI_NAMESPACE),
+                id=self.ids.fresh(f"{edge_id}_di"),
+                bpmnElement=edge_id,
+            )
+            for x, y in _message_waypoints(by_element[source], by_element[target]):
+                ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
 
     def _shape(
         self,
@@ -355,6 +457,7 @@ class _ProcessWriter:
         self.writer = writer
         self.ids = writer.ids
         self.process = process
+        self.stack = writer.stacks[process.id]
         self.element = element
         self.inputs: dict[str, list[str]] = defaultdict(list)
         self.outputs: dict[str, list[str]] = defaultdict(list)
@@ -374,6 +477,10 @@ class _ProcessWriter:
         """hrc transition id -> the element its incoming flows go to (the task, or its join)."""
         self.nodes: list[ET.Element] = []
         self.flows: list[ET.Element] = []
+        self.definitions: dict[str, ET.Element] = {}
+        """XML id of an event -> its event definition (a timer or a message)."""
+        self.catching: set[str] = set()
+        """The XML ids of the catch events, which an event-based gateway may lead to."""
 
     def write(self) -> None:
         lane_set = ET.SubElement(
@@ -397,6 +504,8 @@ class _ProcessWriter:
             for local, flows in (("incoming", incoming[node_id]), ("outgoing", outgoing[node_id])):
                 for flow_id in flows:
                     ET.SubElement(node, _tag(local)).text = flow_id
+            if node_id in self.definitions:  # after the flows, as BPMN's schema orders them
+                node.append(self.definitions[node_id])
             self.element.append(node)
         for flow in self.flows:
             self.element.append(flow)
@@ -417,7 +526,7 @@ class _ProcessWriter:
         if actor is not None:
             lane.set(_tag("actorType", HRC_NAMESPACE), actor.type)
         _add_extra(lane, extra)
-        band = self.writer.bands.get(actor_id if actor is not None else None)
+        band = self.stack.lanes.get(self.writer.band_key(actor_id))
         if band is not None:
             left = POOL_HEADER_WIDTH
             self.writer.pool_lanes.append(
@@ -438,6 +547,12 @@ class _ProcessWriter:
         xml_id, faithful = self.ids.own(transition.id, "transition")
         if not faithful:
             extra["id"] = transition.id
+        event = None if transition.is_task else self._event(transition, xml_id)
+        if event is not None:
+            kind, definition = event
+            self.definitions[xml_id] = definition
+            if kind == "intermediateCatchEvent":
+                self.catching.add(xml_id)
         element = ET.Element(_tag(kind), id=xml_id)
         label = transition.label
         if label is not None:
@@ -457,16 +572,55 @@ class _ProcessWriter:
             lane = lanes.get(transition.performer or "")
             if lane is not None:
                 ET.SubElement(lane, _tag("flowNodeRef")).text = xml_id
-            if len(self.inputs[transition.id]) > 1:
-                # BPMN merges flows into a task; the net's task waits for all its inputs.
-                join = self.ids.fresh(f"{xml_id}_join")
-                self.nodes.append(ET.Element(_tag("parallelGateway"), id=join))
-                left = centre[0] - TASK_WIDTH / 2 - JOIN_SIZE / 2 - 2
-                self._shape(join, (left, centre[1]), (JOIN_SIZE, JOIN_SIZE))
-                self._flow(join, xml_id)
-                self.entry_of[transition.id] = join
+            self._sender(transition, xml_id)
+        elif event is not None:
+            self._shape(xml_id, centre, (EVENT_SIZE, EVENT_SIZE))
         else:
             self._shape(xml_id, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
+        if len(self.inputs[transition.id]) > 1 and kind != "parallelGateway":
+            # BPMN merges flows into a task or an event; the net's transition waits for all its inputs.
+            join = self.ids.fresh(f"{xml_id}_join")
+            self.nodes.append(ET.Element(_tag("parallelGateway"), id=join))
+            width = TASK_WIDTH if transition.is_task else EVENT_SIZE
+            left = centre[0] - width / 2 - JOIN_SIZE / 2 - 2
+            self._shape(join, (left, centre[1]), (JOIN_SIZE, JOIN_SIZE))
+            self._flow(join, xml_id)
+            self.entry_of[transition.id] = join
+
+    def _event(self, transition: Transition, xml_id: str) -> tuple[str, ET.Element] | None:
+        """(kind, event definition) of a silent transition that waits for a timer or a message,
+        or sends one; None for a plain silent step (a parallel gateway)."""
+        timer, message = transition.extra.get("timer"), transition.extra.get("message")
+        if isinstance(timer, str) and _is_text(timer):
+            definition = ET.Element(
+                _tag("timerEventDefinition"), id=self.ids.fresh(f"{xml_id}_timer")
+            )
+            duration = ET.SubElement(definition, _tag("timeDuration"))
+            duration.set(_tag("type", XSI_NAMESPACE), "bpmn:tFormalExpression")
+            duration.text = timer
+            return "intermediateCatchEvent", definition
+        name = _message_name(message)
+        if name is not None:
+            self.writer.catchers.append((self.process.id, xml_id, name))
+            return "intermediateCatchEvent", self._message_definition(xml_id, name)
+        name = _message_name(transition.extra.get("send"))
+        if name is not None:
+            self._sender(transition, xml_id)
+            return "intermediateThrowEvent", self._message_definition(xml_id, name)
+        return None
+
+    def _message_definition(self, xml_id: str, name: str) -> ET.Element:
+        return ET.Element(
+            _tag("messageEventDefinition"),
+            id=self.ids.fresh(f"{xml_id}_message"),
+            messageRef=self.writer.message(name),
+        )
+
+    def _sender(self, transition: Transition, xml_id: str) -> None:
+        name = _message_name(transition.extra.get("send"))
+        if name is not None:
+            self.writer.message(name)
+            self.writer.senders.append((self.process.id, xml_id, name))
 
     # Places.
 
@@ -495,7 +649,7 @@ class _ProcessWriter:
             carry(start, faithful)
             if len(consumers) > 1:
                 split = self.ids.fresh(f"{event}_split")
-                self._node("exclusiveGateway", split)
+                self._node(self._choice(consumers), split)
                 self._shape(event, (centre[0] - 25, centre[1]), (EVENT_SIZE, EVENT_SIZE))
                 self._shape(split, (centre[0] + 25, centre[1]), (GATEWAY_SIZE, GATEWAY_SIZE))
                 self._flow(event, split)
@@ -516,7 +670,7 @@ class _ProcessWriter:
             carry(self._flow(producers[0], consumers[0], flow_id), faithful)
         elif len(producers) == 1:  # a choice: the flow into the gateway is the place
             split = self.ids.fresh(f"{place.id}_split")
-            self._node("exclusiveGateway", split)
+            self._node(self._choice(consumers), split)
             self._shape(split, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
             carry(self._flow(producers[0], split, flow_id), faithful)
@@ -532,12 +686,16 @@ class _ProcessWriter:
             carry(self._flow(merge, consumers[0], flow_id), faithful)
         else:
             gateway, faithful = self.ids.own(place.id, f"{place.id}_gateway")
-            carry(self._node("exclusiveGateway", gateway), faithful)
+            carry(self._node(self._choice(consumers), gateway), faithful)
             self._shape(gateway, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             for producer in producers:
                 self._flow(producer, gateway)
             for consumer in consumers:
                 self._flow(gateway, consumer)
+
+    def _choice(self, consumers: list[str]) -> str:
+        """The gateway of a place's choice: event-based when every branch waits for an event."""
+        return "eventBasedGateway" if set(consumers) <= self.catching else "exclusiveGateway"
 
     def _node(self, kind: str, xml_id: str) -> ET.Element:
         element = ET.Element(_tag(kind), id=xml_id)
@@ -552,7 +710,17 @@ class _ProcessWriter:
         return flow
 
     def _shape(self, element: str, centre: tuple[float, float], size: tuple[float, float]) -> None:
-        self.writer.shapes.append(_Shape(element, centre, size))
+        """A shape at its layout position, moved into the process' pool."""
+        x, y = centre
+        self.writer.shapes.append(_Shape(element, (x, self.stack.y(y)), size))
+
+
+def _message_name(value: object) -> str | None:
+    """The name of a `send` or `message` object; None when there is none to show."""
+    if not isinstance(value, dict):
+        return None
+    name = value.get("name")
+    return name if isinstance(name, str) and name else None
 
 
 def _add_extra(element: ET.Element, data: Json) -> None:
@@ -581,6 +749,19 @@ def _waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
         return [(start, sy), (middle, sy), (middle, ty), (end, ty)]
     below = max(sy + sh / 2, ty + th / 2) + 20
     return [(sx, sy + sh / 2), (sx, below), (tx, below), (tx, ty + th / 2)]
+
+
+def _message_waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
+    """From the sender's side facing the catcher's pool to the catcher, bending half-way."""
+    (sx, sy), (_, sh) = source.centre, source.size
+    (tx, ty), (_, th) = target.centre, target.size
+    down = ty > sy
+    start = sy + sh / 2 if down else sy - sh / 2
+    end = ty - th / 2 if down else ty + th / 2
+    if sx == tx:
+        return [(sx, start), (tx, end)]
+    middle = (start + end) / 2
+    return [(sx, start), (sx, middle), (tx, middle), (tx, end)]
 
 
 def _num(value: float) -> str:
