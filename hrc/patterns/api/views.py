@@ -89,6 +89,11 @@ DOCUMENT_REQUEST = {"application/json": OpenApiTypes.OBJECT}
 DOCUMENT_REFUSED = OpenApiResponse(
     DocumentErrorSerializer, description="The body is not a readable hrc-pattern/1 document."
 )
+IMPORT_REFUSED = OpenApiResponse(
+    DocumentErrorSerializer,
+    description="The body cannot be imported: a JSON body is not a readable hrc-pattern/1 "
+    "document; a PNML or BPMN file is named as such (`The BPMN file cannot be imported: ...`).",
+)
 EXPORT_RESPONSES = {
     (200, "application/json"): OpenApiTypes.OBJECT,
     (200, "application/xml"): OpenApiTypes.STR,
@@ -221,7 +226,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
             ),
         ],
         request={"application/json": OpenApiTypes.OBJECT, "application/xml": OpenApiTypes.STR},
-        responses={201: PatternSerializer, 400: DocumentErrorSerializer},
+        responses={201: PatternSerializer, 400: IMPORT_REFUSED},
     )
     @action(
         detail=False, methods=["post"], url_path="import", url_name="import",
@@ -234,7 +239,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         its root is BPMN's `<definitions>`, PNML otherwise. PNML and BPMN models are
         laid out in their actors' lanes unless they bring a position for every node.
         A file that cannot be read, or a BPMN feature the mapping does not cover, is a
-        400 naming the element, and nothing is created.
+        400 naming the file's format and the elements (`The PNML file cannot be imported:
+        ...`), and nothing is created.
         """
         organisation = target_organisation(request, _id_param(request, "organisation"))
         xml_body = (request.content_type or "").split(";")[0].strip() in XML_MEDIA_TYPES
