@@ -87,3 +87,36 @@ def test_a_json_body_that_is_no_pattern_is_still_called_a_document(
 
     assert response.status_code == 400
     assert response.data["detail"].startswith("The document is not a readable hrc-pattern/1")
+
+
+PIPE_NET = """<?xml version="1.0" encoding="iso-8859-1"?>
+<pnml><net id="Net-One" type="P/T net"><token id="Default" enabled="true"/>
+<place id="P0"><name><value>waiting room</value></name>
+  <initialMarking><value>Default,1</value></initialMarking></place>
+<place id="P1"><name><value>treated</value></name><initialMarking><value>0</value></initialMarking></place>
+<transition id="T0"><name><value>treat</value></name><timed><value>true</value></timed></transition>
+<arc id="P0 to T0" source="P0" target="T0"><type value="normal"/>
+  <inscription><value>Default,1</value></inscription></arc>
+<arc id="T0 to P1" source="T0" target="P1"><type value="inhibitor"/>
+  <inscription><value>Default,1</value></inscription></arc>
+</net></pnml>"""
+
+
+def test_a_pipe_net_imports_and_what_it_cannot_say_is_refused_by_element(
+    engineer_client: APIClient,
+) -> None:
+    refused = _import(engineer_client, PIPE_NET)
+    assert refused.status_code == 400
+    assert refused.data["detail"] == (
+        "The PNML file cannot be imported: Arc T0 to P1 (“treat” -> “treated”) is a PIPE "
+        "inhibitor arc; hrc nets have only normal arcs, each moving one token (an inhibitor arc "
+        "tests a place for emptiness, which hrc's nets cannot say)."
+    )
+
+    imported = _import(engineer_client, PIPE_NET.replace('"inhibitor"', '"normal"'))
+    assert imported.status_code == 201, imported.data
+    places = imported.data["draft"]["processes"][0]["places"]
+    assert [(p["id"], p.get("name"), p.get("tokens")) for p in places] == [
+        ("P0", "waiting room", 1),
+        ("P1", "treated", 0),
+    ]
