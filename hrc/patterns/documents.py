@@ -29,7 +29,7 @@ from typing import Any
 from django.core.exceptions import ValidationError
 
 from hrc.engine import FORMAT, FormatError, read_pattern, write_pattern
-from hrc.engine.bpmn import bpmn_to_pattern, is_bpmn
+from hrc.engine.bpmn import Called, bpmn_to_pattern, is_bpmn
 from hrc.engine.bpmn_export import pattern_to_bpmn
 from hrc.engine.issues import Issue
 from hrc.engine.layout import is_laid_out, lay_out_pattern
@@ -121,14 +121,15 @@ def from_pnml(text: bytes) -> dict[str, Any]:
         raise FileRefused("PNML", refusal) from None
 
 
-def from_bpmn(text: bytes) -> dict[str, Any]:
+def from_bpmn(text: bytes, called: Called | None = None) -> dict[str, Any]:
     """An `hrc-pattern/1` document from BPMN 2.0, laid out in its actors' lanes.
 
-    Raises FileRefused naming the elements on bad or hostile XML and on what the mapping
-    does not cover.
+    `called` finds the published pattern a call activity names when the file has no
+    process of that id (hrc.engine.bpmn). Raises FileRefused naming the elements on bad
+    or hostile XML and on what the mapping does not cover.
     """
     try:
-        return write_pattern(_drawn(bpmn_to_pattern(text)))
+        return write_pattern(_drawn(bpmn_to_pattern(text, called)))
     except FormatError as refusal:
         raise FileRefused("BPMN", refusal) from None
 

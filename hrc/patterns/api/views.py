@@ -12,6 +12,7 @@ organisations: an outsider gets 404, a user without membership an empty list.
 
 import json
 import re
+from functools import partial
 from typing import Any
 
 from django.db.models import QuerySet
@@ -71,6 +72,7 @@ from hrc.patterns.documents import (
 from hrc.patterns.models import PatternModel, PatternVersion
 from hrc.patterns.selectors import (
     patterns_visible_to,
+    published_pattern_named,
     versions_of,
     versions_startable_at,
     versions_visible_to,
@@ -253,7 +255,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
             if document_format == DocumentFormat.PNML:
                 document: object = from_pnml(body)
             elif document_format == DocumentFormat.BPMN:
-                document = from_bpmn(body)
+                document = from_bpmn(body, partial(published_pattern_named, organisation))
             else:
                 document = parse_json_body(body)
             pattern = services.import_pattern(
