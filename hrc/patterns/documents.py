@@ -23,13 +23,13 @@ __all__ = [
 ]
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from django.core.exceptions import ValidationError
 
 from hrc.engine import FORMAT, FormatError, read_pattern, write_pattern
-from hrc.engine.bpmn import Called, bpmn_to_pattern, is_bpmn
+from hrc.engine.bpmn import bpmn_to_pattern, is_bpmn
 from hrc.engine.bpmn_export import pattern_to_bpmn
 from hrc.engine.issues import Issue
 from hrc.engine.layout import is_laid_out, lay_out_pattern
@@ -46,6 +46,8 @@ MAX_DEPTH = 64
 DEFAULT_WORKPIECE = "workpiece"
 
 Report = dict[str, Any]
+Called = Callable[[list[str]], Pattern | None]
+"""What finds the published pattern a BPMN call activity names (hrc.engine.bpmn's `called`)."""
 
 
 def read_draft(document: object) -> Pattern:
