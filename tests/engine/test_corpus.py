@@ -139,6 +139,17 @@ def test_every_bonita_export_imports(outcomes: list[Outcome]) -> None:
     assert [o.file for o in bonita if not o.imported] == []
 
 
+def test_the_check_decides_the_soundness_of_every_real_bpmn_model_imported(
+    outcomes: list[Outcome],
+) -> None:
+    undecided = [
+        f"{outcome.file}: {outcome.verdict}"
+        for outcome in _real_bpmn(outcomes)
+        if outcome.imported and outcome.verdict not in ("sound", "unsound")
+    ]
+    assert not undecided, "\n".join(undecided)
+
+
 def _real_bpmn(outcomes: list[Outcome]) -> list[Outcome]:
     return [
         outcome
