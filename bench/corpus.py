@@ -140,9 +140,11 @@ def print_table(report: dict[str, Any]) -> None:
         print(f"{label:28} " + " ".join(f"{cell:>9}" for cell in cells))
     largest = report["largest"]
     if largest:
+        verdict = {True: "sound", False: "unsound", None: "soundness undecided"}[largest["sound"]]
+        explored = f", {largest['markings']} markings" if largest["markings"] is not None else ""
         print(
             f"largest model: {largest['file']} ({largest['nodes']} places and transitions, "
-            f"{largest['bytes'] / 1024:.0f} KiB, {largest['markings']} markings)"
+            f"{largest['bytes'] / 1024:.0f} KiB; {verdict}{explored})"
         )
     print_load(report)
 
