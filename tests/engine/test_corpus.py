@@ -14,6 +14,7 @@ import difflib
 import os
 import re
 import xml.etree.ElementTree as ET
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -125,6 +126,17 @@ def test_every_refusal_names_its_elements_and_each_by_its_name(outcomes: list[Ou
                 if names.get(element) and _spaced(names[element]) not in message
             ]
     assert not unnamed, "\n".join(unnamed)
+
+
+def test_no_refusal_says_a_thing_twice(outcomes: list[Outcome]) -> None:
+    """One issue per element: a node refused once is not named again by each flow touching it."""
+    repeated: list[str] = []
+    for outcome in outcomes:
+        named = Counter(element for issue in outcome.refusal for element in set(issue.elements))
+        said = Counter(issue.message for issue in outcome.refusal)
+        repeated += [f"{outcome.file}: {e} in {n} issues" for e, n in named.items() if n > 1]
+        repeated += [f"{outcome.file}: said {n} times: {m}" for m, n in said.items() if n > 1]
+    assert not repeated, "\n".join(repeated)
 
 
 def test_at_least_45_of_the_50_real_bpmn_models_import(outcomes: list[Outcome]) -> None:
