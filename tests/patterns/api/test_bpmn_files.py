@@ -88,21 +88,21 @@ def test_a_bpmn_file_imports_as_a_laid_out_pattern(
         ),
         (
             ASSEMBLY_BPMN.replace(
-                '<task id="pick" name="pick insert"/>', '<transaction id="pick"/>'
+                '<task id="pick" name="pick insert"/>', '<subProcess id="pick"/>'
             ),
             "pick",
         ),
         (
             ASSEMBLY_BPMN.replace(
                 '<startEvent id="start"/>',
-                '<startEvent id="start"><compensateEventDefinition/></startEvent>',
+                '<startEvent id="start"><timerEventDefinition/></startEvent>',
             ),
             "start",
         ),
         (ASSEMBLY_BPMN.replace('targetRef="done"', 'targetRef="nowhere"'), "f6"),
         (ASSEMBLY_BPMN.replace("</process>", ""), "line"),
     ],
-    ids=["inclusive-gateway", "transaction", "compensation-event", "dangling-flow", "malformed"],
+    ids=["inclusive-gateway", "subprocess", "timer-event", "dangling-flow", "malformed"],
 )
 def test_a_bpmn_file_that_cannot_be_mapped_is_a_400_naming_the_element_and_creates_nothing(
     engineer_client: APIClient, body: str, named: str
