@@ -38,8 +38,21 @@ def _import(client: APIClient, body: str) -> Any:
 
 
 def _publish(organisation: Organisation, name: str, by: User) -> None:
-    pattern = factories.make_pattern(organisation, name=name, created_by=by)
+    """Publishes a pattern whose tasks say whose they are: `<name>: prepare`, `<name>: place`."""
+    document = factories.valid_document()
+    labels = iter((f"{name}: prepare", f"{name}: place"))
+    for transition in document["processes"][0]["transitions"]:
+        transition["label"] = next(labels)
+    pattern = factories.make_pattern(organisation, name=name, created_by=by, draft=document)
     services.publish_pattern(pattern, published_by=by)
+
+
+def _labels(draft: dict[str, Any]) -> list[str]:
+    return [
+        transition.get("label") or ""
+        for process in draft["processes"]
+        for transition in process["transitions"]
+    ]
 
 
 def test_a_call_activity_naming_a_published_pattern_of_the_organisation_imports(
@@ -50,12 +63,9 @@ def test_a_call_activity_naming_a_published_pattern_of_the_organisation_imports(
     response = _import(engineer_client, CALLING_BPMN)
 
     assert response.status_code == 201, response.data
-    labels = [
-        transition.get("label")
-        for process in response.data["draft"]["processes"]
-        for transition in process["transitions"]
-    ]
-    assert "tape the spots" in labels
+    labels = _labels(response.data["draft"])
+    assert any("tape the spots" in label for label in labels)
+    assert {"spottape: prepare", "spottape: place"} <= set(labels)
 
 
 def test_the_call_activity_may_name_the_pattern_by_its_own_name(
@@ -66,6 +76,7 @@ def test_the_call_activity_may_name_the_pattern_by_its_own_name(
     response = _import(engineer_client, CALLING_BPMN)
 
     assert response.status_code == 201, response.data
+    assert "Tape the spots: place" in _labels(response.data["draft"])
 
 
 def test_another_organisations_pattern_of_that_name_is_never_called(
