@@ -60,8 +60,9 @@ $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
 	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
 	@touch $@
 
-bench: $(BENCH_STAMP)  ## soundness check vs Woflan, cobot handshake vs raw OPC UA, case runtime; JSON in bench/results/
+bench: $(BENCH_STAMP)  ## soundness check vs Woflan, corpus import, cobot handshake vs raw OPC UA, case runtime; JSON in bench/results/
 	$(PY) -m bench.run
+	$(PY) -m bench.corpus
 	$(PY) -m bench.handshake
 	$(PY) -m bench.runtime
 	$(PY) -m bench.editor

@@ -124,15 +124,8 @@ class _Explainer:
             )
             elements = [e for _, ends in waits for e in ends]
         elif fault.kind == "improper":
-            left = sorted(
-                p for p in marking if p not in self.net.final and p not in self.net.ignored
-            )
-            message = (
-                f"The case can end with work left over: {sequence}, the end place has its token "
-                f"while {', '.join(self.place_words(p) for p in left)} still "
-                f"{'holds one' if len(left) == 1 else 'hold tokens'}."
-            )
-            elements = [self.task_of(p) for p in left]
+            message, elements = self.left_over(marking)
+            message = f"The case can end with work left over: {sequence}, {message}."
         elif fault.kind == "livelock":
             message = (
                 f"The case can loop without end: {sequence}, it can no longer reach its end "
@@ -156,6 +149,29 @@ class _Explainer:
         return Issue(
             "unsound", message, tuple(dict.fromkeys(elements)), witness=self.labels(fault.witness)
         )
+
+    def left_over(self, marking: Marking) -> tuple[str, list[str]]:
+        """What an improper end leaves, each place with its count: tokens beside the end
+        place's, and tokens on an end place beyond the one a finished case leaves there."""
+        final = self.net.final
+        surplus = sorted(p for p in final if marking.get(p) > final[p])
+        left = sorted(p for p in marking if p not in final and p not in self.net.ignored)
+        holds = [self.still_holds(p, marking[p]) for p in left]
+        elements = [*surplus, *(self.task_of(p) for p in left)]
+        if not surplus:
+            return f"the end place has its token while {_joined(holds)}", elements
+        ends = [
+            f"the end {self.names.place(p)} holds {_tokens(marking[p])} where a finished case "
+            f"leaves {_tokens(final[p])}"
+            for p in surplus
+        ]
+        return _joined(ends + holds), elements
+
+    def still_holds(self, place: str, count: int) -> str:
+        if place.startswith("running:"):
+            task = self.names.task(place.split(":", 1)[1])
+            return f"{task} is still running" + ("" if count == 1 else f" {count} times")
+        return f"{self.names.place(place)} still holds {_tokens(count)}"
 
     def dead(self, faults: list[Fault]) -> Issue:
         """One issue for every transition that never fires: a task whose start is dead is listed once."""
@@ -250,3 +266,11 @@ class _Explainer:
         if not firings:
             return "right at the start"
         return "after " + ", ".join(self.step(f) for f in firings)
+
+
+def _tokens(count: int) -> str:
+    return "1 token" if count == 1 else f"{count} tokens"
+
+
+def _joined(words: list[str]) -> str:
+    return words[0] if len(words) == 1 else f"{', '.join(words[:-1])} and {words[-1]}"

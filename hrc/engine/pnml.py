@@ -19,6 +19,14 @@ the same shape checks as a JSON one and fails with the same `FormatError`.
 Arcs are kept as written: an arc to a node that does not exist is the rules'
 `unknown-node`, as in a JSON document.
 
+PIPE writes its own dialect: the net type `P/T net`, names and numbers in
+`<value>` rather than `<text>`, and a number per token colour
+(`Default,1`). A net of one colour reads as a P/T net; PIPE's timing (GSPN
+rates, immediate or timed transitions, priorities) is dropped, as hrc's
+analysis abstracts time away. What would change the net's behaviour is
+refused by element: a second token colour, an inhibitor arc, a place's
+capacity. A foreign net without an id (PIPE 5 writes none) is named `net`.
+
 Places have no label in `hrc-pattern/1`: a place's PNML name is the `name` in
 its extras where it has one, else its id, and a foreign place whose name
 differs from its id keeps it there. Editor positions `x`, `y` in the extras
@@ -49,12 +57,15 @@ from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-igno
 from hrc.engine.document import FORMAT, FormatError, read_pattern, write_pattern
 from hrc.engine.issues import Issue, error
 from hrc.engine.model import Pattern
+from hrc.engine.wording import sentence
 
 PNML_NAMESPACE = "http://www.pnml.org/version-2009/grammar/pnml"
 PTNET_TYPE = "http://www.pnml.org/version-2009/grammar/ptnet"
 CORE_MODEL_TYPE = "http://www.pnml.org/version-2009/grammar/pnmlcoremodel"
 """The type pm4py and ProM write for their P/T nets; read like PTNET_TYPE."""
-NET_TYPES = (PTNET_TYPE, CORE_MODEL_TYPE)
+PIPE_NET_TYPE = "P/T net"
+"""The type PIPE writes on its nets, coloured or not."""
+NET_TYPES = (PTNET_TYPE, CORE_MODEL_TYPE, PIPE_NET_TYPE)
 TOOL = "hrc"
 TOOL_VERSION = "1"
 
@@ -338,6 +349,8 @@ class _Reader:
         self.root = root
         self.ns = ""
         self.issues: list[Issue] = []
+        self.labels: dict[str, str] = {}
+        """Every named element's name by id, for messages."""
 
     def fail(self, message: str, *elements: str) -> None:
         self.issues.append(error("format", message, *elements))
@@ -370,7 +383,15 @@ class _Reader:
         nets = self._children(self.root, "net")
         if not nets:
             raise _refuse("The PNML document has no <net>.")
-        for net in nets:
+        self.labels = {
+            element_id: label
+            for element in self.root.iter()
+            if (element_id := element.get("id")) and (label := self._label(element))
+        }
+        for number, net in enumerate(nets, 1):
+            if not net.get("id") and not self._tool_blocks(net):
+                # The id only names the process; PIPE 5 writes none, and ours always have one.
+                net.set("id", "net" if len(nets) == 1 else f"net{number}")
             self._check_net(net)
         if self.issues:
             raise FormatError(self.issues)
@@ -381,10 +402,34 @@ class _Reader:
         net_type = net.get("type")
         if net_type is not None and net_type not in NET_TYPES:
             self.fail(
-                f"Net {net_id or '(without id)'} has type {net_type!r}; only P/T nets"
-                f" ({PTNET_TYPE} or {CORE_MODEL_TYPE}) can be read.",
+                f"{sentence(self.named('net', net_id or '(without id)'))} has type {net_type!r};"
+                f" only P/T nets ({PTNET_TYPE}, {CORE_MODEL_TYPE} or PIPE's {PIPE_NET_TYPE!r})"
+                " can be read.",
                 *([net_id] if net_id else []),
             )
+        elif net_id and not self._tool_blocks(net):
+            self._check_colours(net, net_id)
+
+    def _check_colours(self, net: ET.Element, net_id: str) -> None:
+        """PIPE's coloured nets: tokens of two colours or more cannot be read as P/T tokens."""
+        used: dict[str, list[str]] = {}
+        numbers = {"place": "initialMarking", "arc": "inscription"}
+        for element in net.iter():
+            kind = self._kind(element)
+            number = self._child(element, numbers[kind]) if kind in numbers else None
+            value = None if number is None else self._value(number)
+            for colour, count in _colour_counts(value or ""):
+                if colour is not None and count.strip() not in ("", "0"):
+                    used.setdefault(colour, []).append(element.get("id", ""))
+        if len(used) < 2:
+            return
+        colours = ", ".join(f"{colour} ({_count_words(ids)})" for colour, ids in used.items())
+        self.fail(
+            f"{sentence(self.named('net', net_id))} is a coloured PIPE net: its places and arcs"
+            f" carry tokens of {len(used)} colours, {colours}. hrc's tokens have no colour, so"
+            " only a PIPE net of one token colour can be read.",
+            net_id,
+        )
 
     # Our own files.
 
@@ -537,16 +582,28 @@ class _Reader:
         marking = self._child(node.element, "initialMarking")
         if marking is not None:
             tokens = self._count(
-                marking, f"The initial marking of place {node.xml_id}", node.xml_id
+                marking, f"The initial marking of {self.named('place', node.xml_id)}", node.xml_id
             )
             if tokens is not None:
                 place["tokens"] = tokens
         if own:
             return {**place, **(node.tool or {})}
+        self._check_capacity(node)
         name = self._label(node.element)
         if name is not None and name != node.xml_id:
             place["name"] = name
         return {**place, **self._position(node.element)}
+
+    def _check_capacity(self, node: _Node) -> None:
+        capacity = self._child(node.element, "capacity")
+        value = None if capacity is None else self._value(capacity)
+        if value is not None and value.strip() not in ("", "0"):
+            self.fail(
+                f"{sentence(self.named('place', node.xml_id))} has a capacity of {value.strip()!r}"
+                " in PIPE; hrc's places have no capacity (PIPE's 0 is none): remove it, or"
+                " draw the limit as a place of free slots.",
+                node.xml_id,
+            )
 
     def _transition(self, node: _Node, *, own: bool) -> Json:
         transition: Json = {"id": node.xml_id}
@@ -571,13 +628,22 @@ class _Reader:
         if not source or not target:
             self.fail(f"Arc {arc_id} needs both a source and a target.", arc_id)
             return None
+        arc_words = f"arc {arc_id} ({self.named_end(source)} -> {self.named_end(target)})"
+        arc_type = self._child(arc, "type")
+        if not own and arc_type is not None and arc_type.get("value", "normal") != "normal":
+            self.fail(
+                f"{sentence(arc_words)} is a PIPE {arc_type.get('value')} arc; hrc nets have only"
+                " normal arcs, each moving one token (an inhibitor arc tests a place for"
+                " emptiness, which hrc's nets cannot say).",
+                arc_id,
+            )
+            return None
         inscription = self._child(arc, "inscription")
         if inscription is not None:
-            where = f"The inscription of arc {arc_id} ({source} -> {target})"
-            weight = self._count(inscription, where, arc_id)
+            weight = self._count(inscription, f"The inscription of {arc_words}", arc_id)
             if weight is not None and weight != 1:
                 self.fail(
-                    f"Arc {arc_id} ({source} -> {target}) has weight {weight}; hrc nets have no"
+                    f"{sentence(arc_words)} has weight {weight}; hrc nets have no"
                     " weighted arcs, each arc moves one token.",
                     arc_id,
                 )
@@ -590,19 +656,50 @@ class _Reader:
     # Labels, numbers, positions.
 
     def _label(self, element: ET.Element) -> str | None:
-        """The `<name><text>` of an element; None when it has none."""
+        """The `<name><text>` of an element (PIPE's `<name><value>`); None when it has none."""
         name = self._child(element, "name")
-        text = None if name is None else self._child(name, "text")
+        return None if name is None else self._value(name)
+
+    def _value(self, element: ET.Element) -> str | None:
+        """The text of an element's `<text>`, or of PIPE's `<value>`; None when it has neither."""
+        text = self._child(element, "text")
+        if text is None:
+            text = self._child(element, "value")
         return None if text is None else text.text or ""
 
+    def named(self, kind: str, element_id: str) -> str:
+        """`place “waiting room” (P0)`, or `place P0` when it has no name but its id."""
+        label = self.labels.get(element_id)
+        return (
+            f"{kind} “{label}” ({element_id})"
+            if label and label != element_id
+            else f"{kind} {element_id}"
+        )
+
+    def named_end(self, element_id: str) -> str:
+        """An arc's end by its name, `“waiting room”`; its id when it has no other name."""
+        label = self.labels.get(element_id)
+        return f"“{label}”" if label and label != element_id else element_id
+
     def _count(self, element: ET.Element, where: str, element_id: str) -> int | None:
-        """The whole number ≥ 0 in an element's `<text>` (a marking, an arc weight)."""
-        text = self._child(element, "text")
-        value = "" if text is None or text.text is None else text.text.strip()
+        """The whole number ≥ 0 in an element's `<text>` (a marking, an arc weight).
+
+        PIPE writes it in `<value>`, as `3` or per token colour (`Default,3`), and an
+        empty `<value>` for none; a net of several colours was refused before.
+        """
+        pipe = self._child(element, "text") is None and self._child(element, "value") is not None
+        written = (self._value(element) or "").strip()
+        counts = [count.strip() for _, count in _colour_counts(written)] if pipe else [written]
+        if pipe and not written:
+            return 0
         # Bounded so that int() never meets Python's limit on digits.
-        if re.fullmatch(r"[0-9]{1,100}", value):
-            return int(value)
-        shown = "nothing" if not value else repr(value if len(value) <= 40 else value[:37] + "...")
+        if all(re.fullmatch(r"[0-9]{1,100}", count) for count in counts):
+            return sum(int(count) for count in counts)
+        shown = (
+            "nothing"
+            if not written
+            else repr(written if len(written) <= 40 else written[:37] + "...")
+        )
         self.fail(f"{where} must be a whole number ≥ 0, got {shown}.", element_id)
         return None
 
@@ -690,3 +787,17 @@ class _Reader:
             return element_id
         self.fail(f"{what} has no id; PNML needs one on every net, page, node and arc.")
         return None
+
+
+def _colour_counts(value: str) -> list[tuple[str | None, str]]:
+    """PIPE's `Default,1,Red,0` as its (colour, count) pairs; a plain `3` as one pair without colour."""
+    if "," not in value:
+        return [(None, value)]
+    parts = value.split(",")
+    if len(parts) % 2:
+        return [(None, value)]  # not pairs: refused as a number that is none
+    return [(parts[i].strip(), parts[i + 1]) for i in range(0, len(parts), 2)]
+
+
+def _count_words(ids: list[str]) -> str:
+    return f"{len(ids)} element" if len(ids) == 1 else f"{len(ids)} elements"

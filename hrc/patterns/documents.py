@@ -5,6 +5,7 @@ the engine's interface is absorbed here.
 """
 
 __all__ = [
+    "FileRefused",
     "FormatError",
     "NoExecutionNet",
     "execution_net",
@@ -22,7 +23,7 @@ __all__ = [
 ]
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from django.core.exceptions import ValidationError
@@ -45,6 +46,8 @@ MAX_DEPTH = 64
 DEFAULT_WORKPIECE = "workpiece"
 
 Report = dict[str, Any]
+Called = Callable[[list[str]], Pattern | None]
+"""What finds the published pattern a BPMN call activity names (hrc.engine.bpmn's `called`)."""
 
 
 def read_draft(document: object) -> Pattern:
@@ -95,20 +98,42 @@ class NoExecutionNet(Invalid):
         self.issues = issues
 
 
+class FileRefused(Invalid):
+    """A PNML or BPMN file that cannot be imported (400), named as what it is: its issues
+    are the importer's, and no `hrc-pattern/1` wording belongs in front of them."""
+
+    code = "file-refused"
+
+    def __init__(self, kind: str, refusal: FormatError) -> None:
+        super().__init__(
+            f"The {kind} file cannot be imported: {refusal}",
+            extra={"errors": [issue.as_dict() for issue in refusal.issues]},
+        )
+        self.issues = refusal.issues
+
+
 def from_pnml(text: bytes) -> dict[str, Any]:
     """An `hrc-pattern/1` document from PNML, laid out unless it brings positions for every node.
 
-    Raises FormatError on bad or hostile XML.
+    Raises FileRefused on bad or hostile XML and on what the reader does not cover.
     """
-    return write_pattern(_drawn(pnml_to_pattern(text)))
+    try:
+        return write_pattern(_drawn(pnml_to_pattern(text)))
+    except FormatError as refusal:
+        raise FileRefused("PNML", refusal) from None
 
 
-def from_bpmn(text: bytes) -> dict[str, Any]:
+def from_bpmn(text: bytes, called: Called | None = None) -> dict[str, Any]:
     """An `hrc-pattern/1` document from BPMN 2.0, laid out in its actors' lanes.
 
-    Raises FormatError naming the element on bad or hostile XML and on what the mapping does not cover.
+    `called` finds the published pattern a call activity names when the file has no
+    process of that id (hrc.engine.bpmn). Raises FileRefused naming the elements on bad
+    or hostile XML and on what the mapping does not cover.
     """
-    return write_pattern(_drawn(bpmn_to_pattern(text)))
+    try:
+        return write_pattern(_drawn(bpmn_to_pattern(text, called)))
+    except FormatError as refusal:
+        raise FileRefused("BPMN", refusal) from None
 
 
 def looks_like_bpmn(text: bytes) -> bool:

@@ -4,8 +4,10 @@ from django.db.models import Max, QuerySet
 
 from hrc.engine import FormatError, read_pattern
 from hrc.engine.issues import Issue
+from hrc.engine.model import Pattern
 from hrc.engine.rules import check_rules
 from hrc.organisations.choices import Role
+from hrc.organisations.models import Organisation
 from hrc.organisations.selectors import AnyUser, organisations_of, role_in
 from hrc.patterns.models import PatternModel, PatternVersion
 
@@ -33,6 +35,28 @@ def versions_of(pattern: PatternModel) -> QuerySet[PatternVersion]:
 
 def latest_version(pattern: PatternModel) -> PatternVersion | None:
     return versions_of(pattern).first()
+
+
+def published_pattern_named(organisation: Organisation, names: list[str]) -> Pattern | None:
+    """The pattern of the latest version in service of the organisation's pattern named one of
+    `names` (case-insensitive, the first name that finds one wins); None when none does.
+
+    This is how a BPMN call activity finds the pattern it calls: by the called element,
+    then by its own name. Only `organisation`'s patterns are looked at (organisations are
+    walls), and retired versions are passed over, as they start no new cases.
+    """
+    in_service = PatternVersion.objects.filter(
+        pattern__organisation=organisation, retired_at__isnull=True
+    )
+    for name in (name.strip() for name in names):
+        version = (
+            in_service.filter(pattern__name__iexact=name).order_by("-published_at", "-pk").first()
+            if name
+            else None
+        )
+        if version is not None:
+            return read_pattern(version.document)
+    return None
 
 
 def why_may_not_start(user: AnyUser, version: PatternVersion, *, cell: str = "") -> str | None:

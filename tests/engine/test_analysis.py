@@ -6,6 +6,7 @@ from hrc.engine import check_document, read_pattern
 from hrc.engine.analysis import analyse
 from hrc.engine.budget import Budget
 from hrc.engine.execution import build_execution_net
+from hrc.engine.issues import Issue
 from hrc.engine.petri import Marking, Net, NetTransition
 from hrc.engine.reduction import reduce_net
 from tests.engine.builders import document, process, two_lanes
@@ -64,7 +65,54 @@ def test_an_exclusive_branch_without_its_join_ends_with_work_left_over() -> None
     improper = next(e for e in errors if "left over" in e.message)
     assert improper.witness is not None
     assert improper.witness[-1] == "complete to2"
-    assert "the running task" in improper.message or "place p" in improper.message
+    assert improper.message.endswith(
+        "the end place has its token while place p3 still holds 1 token."
+    )
+    assert improper.elements == ("p3",)
+
+
+def _marked(data: dict[str, Any], tokens: dict[str, int]) -> dict[str, Any]:
+    for place in data["processes"][0]["places"]:
+        if place["id"] in tokens:
+            place["tokens"] = tokens[place["id"]]
+    return data
+
+
+def _left_over(data: dict[str, Any]) -> Issue:
+    return next(e for e in check_document(data).errors if "left over" in e.message)
+
+
+def test_tokens_left_on_the_end_place_itself_are_named_with_their_count() -> None:
+    data = _marked(document(process("N", "p1 t1 p2", performers={"t1": "o"})), {"p2": 100})
+
+    improper = _left_over(data)
+
+    assert improper.message == (
+        "The case can end with work left over: right at the start, the end place p2 holds "
+        "100 tokens where a finished case leaves 1 token."
+    )
+    assert improper.elements == ("p2",)
+
+
+def test_a_place_left_with_many_tokens_says_how_many() -> None:
+    net = process("N", "p1 t1 p2 t2 p3", performers={"t1": "o", "t2": "o"})
+
+    improper = _left_over(_marked(document(net), {"p1": 100}))
+
+    assert improper.message.endswith("while place p1 still holds 99 tokens.")
+    assert improper.elements == ("p1",)
+
+
+def test_an_end_place_with_a_token_too_many_and_a_place_beside_it_are_both_named() -> None:
+    net = process("N", "p1 t1 p2 t2 p3", performers={"t1": "o", "t2": "o"})
+
+    improper = _left_over(_marked(document(net), {"p1": 1, "p3": 2}))
+
+    assert improper.message == (
+        "The case can end with work left over: right at the start, the end place p3 holds "
+        "2 tokens where a finished case leaves 1 token and place p1 still holds 1 token."
+    )
+    assert improper.elements == ("p3", "p1")
 
 
 def test_a_loop_that_can_never_leave_is_a_livelock_with_its_way_in() -> None:

@@ -453,6 +453,138 @@ def test_each_foreign_net_becomes_a_process_and_dangling_arcs_are_kept() -> None
     assert pattern.processes[1].arcs == (("u1", "q1"),)
 
 
+# PIPE's dialect ------------------------------------------------------------------------------
+
+
+def pipe_net(
+    places: str, transitions: str, arcs: str, tokens: str = '<token id="Default" enabled="true"/>'
+) -> str:
+    """A net as PIPE writes it: no namespace, type `P/T net`, names and numbers in `<value>`."""
+    return f"""<?xml version="1.0" encoding="iso-8859-1"?>
+<pnml><net id="Net-One" type="P/T net">{tokens}
+<labels x="10" y="10" width="40" height="20" border="false"><text>a note</text></labels>
+{places}{transitions}{arcs}<stategroup name="done" id="s1"/></net></pnml>"""
+
+
+def pipe_place(place_id: str, name: str, marking: str, capacity: str = "0") -> str:
+    return f"""<place id="{place_id}"><graphics><position x="135.0" y="120.0"/></graphics>
+<name><value>{name}</value><graphics/></name>
+<initialMarking><value>{marking}</value><graphics/></initialMarking>
+<capacity><value>{capacity}</value></capacity></place>"""
+
+
+def pipe_transition(transition_id: str, name: str, timed: str = "true") -> str:
+    return f"""<transition id="{transition_id}"><graphics><position x="255.0" y="120.0"/></graphics>
+<name><value>{name}</value><graphics/></name><orientation><value>0</value></orientation>
+<rate><value>2.5</value></rate><timed><value>{timed}</value></timed>
+<infiniteServer><value>false</value></infiniteServer><priority><value>1</value></priority>
+</transition>"""
+
+
+def pipe_arc(source: str, target: str, weight: str = "Default,1", kind: str = "normal") -> str:
+    return f"""<arc id="{source} to {target}" source="{source}" target="{target}">
+<arcpath id="000" x="150" y="120" curvePoint="false"/><type value="{kind}"/>
+<inscription><value>{weight}</value><graphics/></inscription><tagged><value>false</value></tagged></arc>"""
+
+
+PIPE_PLACES = (
+    pipe_place("P0", "waiting room", "Default,1")
+    + pipe_place("P1", "in treatment", "")
+    + pipe_place("P2", "P2", "0")
+)
+PIPE_TRANSITIONS = pipe_transition("T0", "admit") + pipe_transition("T1", "T1", timed="false")
+PIPE_ARCS = (
+    pipe_arc("P0", "T0") + pipe_arc("T0", "P1", "1") + pipe_arc("P1", "T1") + pipe_arc("T1", "P2")
+)
+
+
+def test_a_pipe_net_reads_as_its_p_t_net_with_names_and_markings_and_without_timing() -> None:
+    pattern = pnml_to_pattern(pipe_net(PIPE_PLACES, PIPE_TRANSITIONS, PIPE_ARCS))
+
+    (process,) = pattern.processes
+    assert process.id == "Net-One"
+    assert process.places == (Place("P0", 1), Place("P1", 0), Place("P2", 0))
+    assert process.places[0].extra == {"name": "waiting room", "x": 135, "y": 120}
+    assert process.transitions == (Transition("T0", None, "admit"), Transition("T1", None, "T1"))
+    assert process.arcs == (("P0", "T0"), ("T0", "P1"), ("P1", "T1"), ("T1", "P2"))
+    assert "rate" not in json.dumps(write_pattern(pattern))
+
+
+def test_a_pipe_net_checks_like_any_foreign_net() -> None:
+    report = check_pattern(pnml_to_pattern(pipe_net(PIPE_PLACES, PIPE_TRANSITIONS, PIPE_ARCS)))
+
+    assert [issue.code for issue in report.errors] == ["no-actors"]
+
+
+def test_pipe_colours_declared_but_one_used_read_as_a_p_t_net() -> None:
+    tokens = '<token id="Default" enabled="true"/><token id="Red" enabled="true"/>'
+    places = PIPE_PLACES.replace("Default,1", "Default,2,Red,0")
+
+    pattern = pnml_to_pattern(pipe_net(places, PIPE_TRANSITIONS, PIPE_ARCS, tokens))
+
+    assert pattern.processes[0].places[0].tokens == 2
+
+
+def test_a_coloured_pipe_net_is_refused_naming_the_net_and_its_colours() -> None:
+    tokens = '<token id="Default" enabled="true"/><token id="Red" enabled="true"/>'
+    arcs = PIPE_ARCS.replace(pipe_arc("P1", "T1"), pipe_arc("P1", "T1", "Default,0,Red,1"))
+
+    (issue,) = format_error(pipe_net(PIPE_PLACES, PIPE_TRANSITIONS, arcs, tokens)).issues
+
+    assert issue.elements == ("Net-One",)
+    assert issue.message.startswith("Net Net-One is a coloured PIPE net")
+    assert "2 colours, Default (3 elements), Red (1 element)" in issue.message
+
+
+def test_a_pipe_inhibitor_arc_is_refused_naming_the_arc_and_its_ends_by_name() -> None:
+    arcs = PIPE_ARCS.replace(pipe_arc("P0", "T0"), pipe_arc("P0", "T0", kind="inhibitor"))
+
+    (issue,) = format_error(pipe_net(PIPE_PLACES, PIPE_TRANSITIONS, arcs)).issues
+
+    assert issue.elements == ("P0 to T0",)
+    assert issue.message.startswith(
+        "Arc P0 to T0 (“waiting room” -> “admit”) is a PIPE inhibitor arc"
+    )
+
+
+def test_a_pipe_place_with_a_capacity_is_refused_by_name() -> None:
+    places = PIPE_PLACES.replace(
+        pipe_place("P1", "in treatment", ""), pipe_place("P1", "in treatment", "", capacity="4")
+    )
+
+    (issue,) = format_error(pipe_net(places, PIPE_TRANSITIONS, PIPE_ARCS)).issues
+
+    assert issue.elements == ("P1",)
+    assert issue.message.startswith("Place “in treatment” (P1) has a capacity of '4'")
+
+
+def test_a_pipe_weight_is_read_per_colour_and_refused_by_the_arcs_names() -> None:
+    arcs = PIPE_ARCS.replace(pipe_arc("P0", "T0"), pipe_arc("P0", "T0", "Default,3"))
+
+    (issue,) = format_error(pipe_net(PIPE_PLACES, PIPE_TRANSITIONS, arcs)).issues
+
+    assert issue.message.startswith("Arc P0 to T0 (“waiting room” -> “admit”) has weight 3")
+
+
+def test_a_pipe_marking_that_is_no_number_is_refused_by_the_places_name() -> None:
+    places = PIPE_PLACES.replace("Default,1", "Default,lots")
+
+    (issue,) = format_error(pipe_net(places, PIPE_TRANSITIONS, PIPE_ARCS)).issues
+
+    assert issue.message == (
+        "The initial marking of place “waiting room” (P0) must be a whole number ≥ 0, "
+        "got 'Default,lots'."
+    )
+
+
+def test_a_foreign_net_without_an_id_is_named_net() -> None:
+    text = pipe_net(PIPE_PLACES, PIPE_TRANSITIONS, PIPE_ARCS).replace(
+        '<net id="Net-One" type="P/T net">', "<net>"
+    )
+
+    assert [process.id for process in pnml_to_pattern(text).processes] == ["net"]
+
+
 # Bad input -------------------------------------------------------------------------------
 
 
@@ -494,7 +626,15 @@ def own_file(changes: list[tuple[str, str]]) -> str:
             "<pnml xmlns='http://example.org/pnml'/>", ["namespace"], [], id="wrong-namespace"
         ),
         pytest.param(f"<pnml xmlns='{PNML_NAMESPACE}'/>", ["no <net>"], [], id="no-net"),
-        pytest.param("<pnml><net type='x'/></pnml>", ["<net> has no id"], [], id="net-without-id"),
+        pytest.param(
+            "<pnml><net><toolspecific tool='hrc' version='1'>{}</toolspecific></net></pnml>",
+            ["<net> has no id"],
+            [],
+            id="own-net-without-id",
+        ),
+        pytest.param(
+            "<pnml><net type='x'/></pnml>", ["Net net has type 'x'"], ["net"], id="net-type"
+        ),
         pytest.param(
             net("", "http://www.pnml.org/version-2009/grammar/symmetricnet"),
             ["symmetricnet", "P/T"],

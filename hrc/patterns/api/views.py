@@ -12,6 +12,7 @@ organisations: an outsider gets 404, a user without membership an empty list.
 
 import json
 import re
+from functools import partial
 from typing import Any
 
 from django.db.models import QuerySet
@@ -71,6 +72,7 @@ from hrc.patterns.documents import (
 from hrc.patterns.models import PatternModel, PatternVersion
 from hrc.patterns.selectors import (
     patterns_visible_to,
+    published_pattern_named,
     versions_of,
     versions_startable_at,
     versions_visible_to,
@@ -88,6 +90,11 @@ FORMAT_PARAMETER = OpenApiParameter(
 DOCUMENT_REQUEST = {"application/json": OpenApiTypes.OBJECT}
 DOCUMENT_REFUSED = OpenApiResponse(
     DocumentErrorSerializer, description="The body is not a readable hrc-pattern/1 document."
+)
+IMPORT_REFUSED = OpenApiResponse(
+    DocumentErrorSerializer,
+    description="The body cannot be imported: a JSON body is not a readable hrc-pattern/1 "
+    "document; a PNML or BPMN file is named as such (`The BPMN file cannot be imported: ...`).",
 )
 EXPORT_RESPONSES = {
     (200, "application/json"): OpenApiTypes.OBJECT,
@@ -221,7 +228,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
             ),
         ],
         request={"application/json": OpenApiTypes.OBJECT, "application/xml": OpenApiTypes.STR},
-        responses={201: PatternSerializer, 400: DocumentErrorSerializer},
+        responses={201: PatternSerializer, 400: IMPORT_REFUSED},
     )
     @action(
         detail=False, methods=["post"], url_path="import", url_name="import",
@@ -234,7 +241,8 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
         its root is BPMN's `<definitions>`, PNML otherwise. PNML and BPMN models are
         laid out in their actors' lanes unless they bring a position for every node.
         A file that cannot be read, or a BPMN feature the mapping does not cover, is a
-        400 naming the element, and nothing is created.
+        400 naming the file's format and the elements (`The PNML file cannot be imported:
+        ...`), and nothing is created.
         """
         organisation = target_organisation(request, _id_param(request, "organisation"))
         xml_body = (request.content_type or "").split(";")[0].strip() in XML_MEDIA_TYPES
@@ -247,7 +255,7 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
             if document_format == DocumentFormat.PNML:
                 document: object = from_pnml(body)
             elif document_format == DocumentFormat.BPMN:
-                document = from_bpmn(body)
+                document = from_bpmn(body, partial(published_pattern_named, organisation))
             else:
                 document = parse_json_body(body)
             pattern = services.import_pattern(
