@@ -50,6 +50,7 @@ from hrc.engine.bpmn import (
     DI_NAMESPACE,
     HRC_NAMESPACE,
 )
+from hrc.engine.bpmn_marks import ARC, JOIN, MARK, MERGE, PLACE, SPLIT, TRANSITION, mark
 from hrc.engine.bpmn_net import TASK_KINDS
 from hrc.engine.document import FormatError
 from hrc.engine.issues import error
@@ -84,9 +85,8 @@ UNREPRESENTABLE = ("duplicate-id", "unknown-node", "arc-kind")
 def pattern_to_bpmn(pattern: Pattern) -> str:
     """The BPMN 2.0 XML of a pattern; raises FormatError when BPMN cannot represent it."""
     _check_representable(pattern)
-    if not is_laid_out(pattern):
-        pattern = lay_out_pattern(pattern)
-    return _Writer(pattern).text()
+    drawn = pattern if is_laid_out(pattern) else lay_out_pattern(pattern)
+    return _Writer(drawn, pattern).text()
 
 
 def _check_representable(pattern: Pattern) -> None:
@@ -199,8 +199,17 @@ class _Stack:
 
 
 class _Writer:
-    def __init__(self, pattern: Pattern) -> None:
+    def __init__(self, pattern: Pattern, original: Pattern) -> None:
         self.pattern = pattern
+        """The pattern laid out, for the diagram."""
+        self.original = original
+        """The pattern as given, whose layout (or lack of it) the marks keep."""
+        self.layouts: dict[str, Any] = {
+            node.id: node.extra["layout"]
+            for process in original.processes
+            for node in _nodes(process)
+            if "layout" in node.extra
+        }
         self.ids = _Ids(pattern)
         self.shapes: list[_Shape] = []
         self.edges: list[tuple[str, str, str]] = []
@@ -269,33 +278,38 @@ class _Writer:
                 "exporterVersion": "1",
             },
         )
-        document_extra: Json = {k: v for k, v in pattern.extra.items() if k != "layout"}
-        if _is_text(pattern.name):
+        document_extra: Json = dict(self.original.extra)
+        if pattern.name and _is_text(pattern.name):
             root.set("name", pattern.name)
-        else:
-            document_extra["name"] = pattern.name
+        if not (pattern.name and _is_text(pattern.name) and pattern.name == pattern.name.strip()):
+            document_extra["name"] = pattern.name  # the importer strips names and needs one
         if pattern.declared_pattern is not None:
             root.set(_tag("declaredPattern", HRC_NAMESPACE), pattern.declared_pattern)
         collaboration = ET.SubElement(
             root, _tag("collaboration"), id=self.ids.fresh("collaboration")
         )
-        # The actors' order (the editor's lanes); import sorts the lanes' actors by it.
-        document_extra["actors"] = [actor.id for actor in pattern.actors]
-        _add_extra(collaboration, document_extra)
+        # The actors' and constraints' order, which import restores; an actor without a lane
+        # and a constraint without an association are given in full.
+        laned = {actor for process in pattern.processes for actor in _lane_actors(process)}
+        document_extra["actors"] = [
+            actor.id if actor.id in laned else {"id": actor.id, "type": actor.type, **actor.extra}
+            for actor in pattern.actors
+        ]
         processes = []
         pools: list[tuple[str, Process]] = []
         for process in pattern.processes:
             element, pool = self._process(process, collaboration)
             processes.append(element)
             pools.append((pool, process))
+        self._message_flows(collaboration)
+        document_extra["constraints"] = self._constraints(collaboration)
+        _add_extra(collaboration, document_extra)
         for name, message_id in self.messages.items():
             message = ET.SubElement(root, _tag("message"), id=message_id)
             if _is_text(name):
                 message.set("name", name)
         for element in processes:
             root.append(element)
-        self._message_flows(collaboration)
-        self._constraints(collaboration)
         self._diagram(root, collaboration.get("id", ""), pools)
         ET.indent(root)
         return (
@@ -309,11 +323,11 @@ class _Writer:
     def _process(self, process: Process, collaboration: ET.Element) -> tuple[ET.Element, str]:
         xml_id, faithful = self.ids.own(process.id, "process")
         element = ET.Element(_tag("process"), id=xml_id, isExecutable="false")
-        extra: Json = {k: v for k, v in process.extra.items() if k != "layout"}
+        extra: Json = dict(process.extra)
         if not faithful:
             extra["id"] = process.id
         name = extra.get("name")
-        if isinstance(name, str) and _is_text(name):
+        if isinstance(name, str) and name and _is_text(name):
             element.set("name", name)
             del extra["name"]
         if process.workpiece is not None:
@@ -321,7 +335,14 @@ class _Writer:
                 element.set(_tag("workpiece", HRC_NAMESPACE), process.workpiece)
             else:
                 extra["workpiece"] = process.workpiece
-        _add_extra(element, extra)
+        net = {
+            "actors": list(process.actors),
+            "places": [place.id for place in process.places],
+            "transitions": [transition.id for transition in process.transitions],
+            "arcs": [list(arc) for arc in process.arcs],
+            "layout": {n.id: self.layouts[n.id] for n in _nodes(process) if n.id in self.layouts},
+        }
+        _add_extra(element, extra, net)
         pool = self.ids.fresh(f"{xml_id}_pool")
         participant = ET.SubElement(collaboration, _tag("participant"), id=pool, processRef=xml_id)
         participant.set("name", element.get("name") or xml_id)
@@ -351,12 +372,23 @@ class _Writer:
                 )
                 self.message_edges.append((flow_id, source, target))
 
-    def _constraints(self, collaboration: ET.Element) -> None:
+    def _constraints(self, collaboration: ET.Element) -> list[str | Json]:
+        """Draws each constraint between two tasks; returns the constraints' order for import."""
+        order: list[str | Json] = []
         for constraint in self.pattern.constraints:
             source = self.element_of.get(constraint.source)
             target = self.element_of.get(constraint.target)
             if source is None or target is None:
-                continue  # a constraint on a silent step: the rules report it, BPMN has no place for it
+                # A constraint on a silent step: the rules report it, BPMN has no place for it.
+                order.append(
+                    {
+                        "from": constraint.source,
+                        "to": constraint.target,
+                        "type": constraint.type,
+                        **constraint.extra,
+                    }
+                )
+                continue
             home = self.process_of_task.get(constraint.source, collaboration)
             association_id = self.ids.fresh(f"{constraint.type}_{source}_{target}")
             association = ET.Element(
@@ -375,6 +407,8 @@ class _Writer:
             _add_extra(association, extra)
             home.append(association)
             self.edges.append((association_id, source, target))
+            order.append(association_id)
+        return order
 
     # The diagram.
 
@@ -518,11 +552,12 @@ class _ProcessWriter:
         if not faithful:
             extra["id"] = actor_id
         name = extra.pop("name", None)
-        if not (isinstance(name, str) and name and _is_text(name)):
+        if not (isinstance(name, str) and name and _is_text(name)) or name == actor_id:
             if name is not None:
-                extra["name"] = name
-            name = actor_id if _is_text(actor_id) else xml_id
-        lane.set("name", name)
+                extra["name"] = name  # import takes a lane named as its actor for unnamed
+            name = actor_id if _is_text(actor_id) else None
+        if name is not None:
+            lane.set("name", name)
         if actor is not None:
             lane.set(_tag("actorType", HRC_NAMESPACE), actor.type)
         _add_extra(lane, extra)
@@ -540,10 +575,10 @@ class _ProcessWriter:
         extra: Json = {k: v for k, v in transition.extra.items() if k != "layout"}
         kind = "parallelGateway"
         if transition.is_task:
-            wanted = extra.pop("bpmn", "task")
+            wanted = extra.get("bpmn", "task")
             kind = wanted if wanted in TASK_KINDS else "task"
-            if wanted not in TASK_KINDS:
-                extra["bpmn"] = wanted
+            if kind != "task":
+                del extra["bpmn"]  # the element's kind says it
         xml_id, faithful = self.ids.own(transition.id, "transition")
         if not faithful:
             extra["id"] = transition.id
@@ -553,7 +588,7 @@ class _ProcessWriter:
             self.definitions[xml_id] = definition
             if kind == "intermediateCatchEvent":
                 self.catching.add(xml_id)
-        element = ET.Element(_tag(kind), id=xml_id)
+        element = ET.Element(_tag(kind), {"id": xml_id, _tag(MARK, HRC_NAMESPACE): mark(TRANSITION, xml_id)})
         label = transition.label
         if label is not None:
             if label and _is_text(label):
@@ -580,7 +615,7 @@ class _ProcessWriter:
         if len(self.inputs[transition.id]) > 1 and kind != "parallelGateway":
             # BPMN merges flows into a task or an event; the net's transition waits for all its inputs.
             join = self.ids.fresh(f"{xml_id}_join")
-            self.nodes.append(ET.Element(_tag("parallelGateway"), id=join))
+            self._node("parallelGateway", join, mark(JOIN, xml_id))
             width = TASK_WIDTH if transition.is_task else EVENT_SIZE
             left = centre[0] - width / 2 - JOIN_SIZE / 2 - 2
             self._shape(join, (left, centre[1]), (JOIN_SIZE, JOIN_SIZE))
@@ -645,11 +680,11 @@ class _ProcessWriter:
 
         if not producers:
             event, faithful = self.ids.own(place.id, f"{place.id}_start")
-            start = self._node("startEvent", event)
+            start = self._node("startEvent", event, mark(PLACE, event))
             carry(start, faithful)
             if len(consumers) > 1:
                 split = self.ids.fresh(f"{event}_split")
-                self._node(self._choice(consumers), split)
+                self._node(self._choice(consumers), split, mark(SPLIT, event))
                 self._shape(event, (centre[0] - 25, centre[1]), (EVENT_SIZE, EVENT_SIZE))
                 self._shape(split, (centre[0] + 25, centre[1]), (GATEWAY_SIZE, GATEWAY_SIZE))
                 self._flow(event, split)
@@ -661,7 +696,7 @@ class _ProcessWriter:
                     self._flow(event, consumer)
         elif not consumers:
             event, faithful = self.ids.own(place.id, f"{place.id}_end")
-            carry(self._node("endEvent", event), faithful)
+            carry(self._node("endEvent", event, mark(PLACE, event)), faithful)
             self._shape(event, centre, (EVENT_SIZE, EVENT_SIZE))
             for producer in producers:
                 self._flow(producer, event)
@@ -670,23 +705,23 @@ class _ProcessWriter:
             carry(self._flow(producers[0], consumers[0], flow_id), faithful)
         elif len(producers) == 1:  # a choice: the flow into the gateway is the place
             split = self.ids.fresh(f"{place.id}_split")
-            self._node(self._choice(consumers), split)
-            self._shape(split, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            self._node(self._choice(consumers), split, mark(SPLIT, flow_id))
+            self._shape(split, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             carry(self._flow(producers[0], split, flow_id), faithful)
             for consumer in consumers:
                 self._flow(split, consumer)
         elif len(consumers) == 1:  # a merge: the flow out of the gateway is the place
             merge = self.ids.fresh(f"{place.id}_merge")
-            self._node("exclusiveGateway", merge)
+            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            self._node("exclusiveGateway", merge, mark(MERGE, flow_id))
             self._shape(merge, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             for producer in producers:
                 self._flow(producer, merge)
-            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
             carry(self._flow(merge, consumers[0], flow_id), faithful)
         else:
             gateway, faithful = self.ids.own(place.id, f"{place.id}_gateway")
-            carry(self._node(self._choice(consumers), gateway), faithful)
+            carry(self._node(self._choice(consumers), gateway, mark(PLACE, gateway)), faithful)
             self._shape(gateway, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             for producer in producers:
                 self._flow(producer, gateway)
@@ -697,14 +732,23 @@ class _ProcessWriter:
         """The gateway of a place's choice: event-based when every branch waits for an event."""
         return "eventBasedGateway" if set(consumers) <= self.catching else "exclusiveGateway"
 
-    def _node(self, kind: str, xml_id: str) -> ET.Element:
-        element = ET.Element(_tag(kind), id=xml_id)
+    def _node(self, kind: str, xml_id: str, stands_for: str) -> ET.Element:
+        element = ET.Element(_tag(kind), {"id": xml_id, _tag(MARK, HRC_NAMESPACE): stands_for})
         self.nodes.append(element)
         return element
 
-    def _flow(self, source: str, target: str, flow_id: str | None = None) -> ET.Element:
-        flow_id = flow_id or self.ids.fresh(f"flow_{source}_{target}")
-        flow = ET.Element(_tag("sequenceFlow"), id=flow_id, sourceRef=source, targetRef=target)
+    def _flow(self, source: str, target: str, place: str | None = None) -> ET.Element:
+        """A sequence flow: the place of that XML id, or an arc between what its ends stand for."""
+        flow_id = place or self.ids.fresh(f"flow_{source}_{target}")
+        flow = ET.Element(
+            _tag("sequenceFlow"),
+            {
+                "id": flow_id,
+                _tag(MARK, HRC_NAMESPACE): mark(PLACE, place) if place else mark(ARC),
+                "sourceRef": source,
+                "targetRef": target,
+            },
+        )
         self.flows.append(flow)
         self.writer.edges.append((flow_id, source, target))
         return flow
@@ -723,17 +767,20 @@ def _message_name(value: object) -> str | None:
     return name if isinstance(name, str) and name else None
 
 
-def _add_extra(element: ET.Element, data: Json) -> None:
-    """The keys BPMN cannot carry, as JSON in `<extensionElements><hrc:extra>`.
+def _add_extra(element: ET.Element, data: Json, net: Json | None = None) -> None:
+    """The keys BPMN cannot carry, as JSON in `<extensionElements><hrc:extra>`, and a
+    process' `<hrc:net>` (`bpmn_marks`).
 
     ASCII-escaped JSON, so any string (even one XML cannot hold) survives.
     """
-    if not data:
+    if not data and net is None:
         return
     holder = ET.Element(_tag("extensionElements"))
-    ET.SubElement(holder, _tag("extra", HRC_NAMESPACE)).text = json.dumps(
-        data, ensure_ascii=True, sort_keys=True
-    )
+    for local, value in (("extra", data or None), (MARK, net)):
+        if value is not None:
+            ET.SubElement(holder, _tag(local, HRC_NAMESPACE)).text = json.dumps(
+                value, ensure_ascii=True, sort_keys=True
+            )
     element.insert(0, holder)  # extensionElements comes first in every BPMN element
 
 
