@@ -55,10 +55,18 @@ and conversations. Nothing else is read from the file, so a refused import
 creates nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the
 pattern in its actors' lanes.
 
-Exclusive gateways choose when they are reached (BPMN's data-based choice),
-not when a task starts: a round trip through `pattern_to_bpmn` keeps the tasks,
-actors, constraints and every sequence of task starts and completions, but a
-choice between two tasks is then made by a silent step just before them.
+hrc's own exports are not mapped: a process whose elements all carry the
+`hrc:net` marks `bpmn_export` writes, still consistent with its `<hrc:net>`,
+is rebuilt from them exactly as it was exported (ids, places, arcs, order,
+layout; names, lanes and task kinds as the file now says), see `bpmn_marks`;
+the collaboration's `<hrc:extra>` restores the order of actors and
+constraints. A process edited in another tool so that a mark is missing or no
+longer fits (a task or flow added or removed, a flow reconnected) is read by
+the mapping above, and then the document keeps no layout. Through the mapping,
+exclusive gateways choose when they are reached (BPMN's data-based choice),
+not when a task starts: the tasks, actors, constraints and every sequence of
+task starts and completions stay, but a choice between two tasks is made by a
+silent step just before them.
 """
 
 import json

@@ -27,6 +27,18 @@ Positions come from the document's `layout` (`layout.lay_out` when it has
 none): tasks, gateways and events at their nodes' centres, pools and lanes as
 the layout's lane bands.
 
+The import gives the same document back, not only the same behaviour: each
+element written carries an `hrc:net` attribute saying what it stands for in
+the net (`transition t1`, `place p2`, the `join`, `split` or `merge` of one, an
+`arc`), and each process an `<hrc:net>` with its actors, its ids and arcs in
+order, and its nodes' layout as given (none when the pattern had none); the
+collaboration's `<hrc:extra>` orders the actors and constraints and gives in
+full those BPMN cannot draw (an actor in no process, a constraint on a silent
+step). `bpmn_marks` says how the import checks and reads them; a process
+edited in another tool so that its marks no longer hold is read by the mapping.
+Both are attributes and elements of the hrc namespace, which OMG's XSD allows
+on every BPMN element.
+
 A net BPMN cannot draw is refused with a FormatError naming the elements:
 duplicate ids, and arcs to unknown nodes or between two places or two
 transitions. Initial tokens travel in `<hrc:extra>` like the rest; other tools
@@ -588,7 +600,9 @@ class _ProcessWriter:
             self.definitions[xml_id] = definition
             if kind == "intermediateCatchEvent":
                 self.catching.add(xml_id)
-        element = ET.Element(_tag(kind), {"id": xml_id, _tag(MARK, HRC_NAMESPACE): mark(TRANSITION, xml_id)})
+        element = ET.Element(
+            _tag(kind), {"id": xml_id, _tag(MARK, HRC_NAMESPACE): mark(TRANSITION, xml_id)}
+        )
         label = transition.label
         if label is not None:
             if label and _is_text(label):

@@ -142,7 +142,9 @@ def _record(process: ET.Element) -> Json | None:
     if not (
         all(isinstance(i, list) and all(isinstance(x, str) for x in i) for i in ids)
         and isinstance(arcs, list)
-        and all(isinstance(a, list) and len(a) == 2 and all(isinstance(x, str) for x in a) for a in arcs)
+        and all(
+            isinstance(a, list) and len(a) == 2 and all(isinstance(x, str) for x in a) for a in arcs
+        )
         and isinstance(record.get("layout"), dict)
     ):
         return None
@@ -219,7 +221,7 @@ class _Marked:
                 self.flows.append((role, child))
                 if role == PLACE:
                     self._add(self.places, self.place_list, child)
-            elif self._fits_node(child, local, role, owner):
+            elif owner is not None and self._fits_node(child, local, role, owner):
                 self.nodes[xml_id] = (role, owner, child)
                 if role == PLACE:
                     self._add(self.places, self.place_list, child)
@@ -239,8 +241,8 @@ class _Marked:
         own = owner == flow.get("id") if role == PLACE else owner is None and role == ARC
         return inside and own
 
-    def _fits_node(self, element: ET.Element, local: str, role: str, owner: str | None) -> bool:
-        if owner is None or local not in MARKED_KINDS.get(role, ()):
+    def _fits_node(self, element: ET.Element, local: str, role: str, owner: str) -> bool:
+        if local not in MARKED_KINDS.get(role, ()):
             return False
         if role in (TRANSITION, PLACE) and owner != element.get("id"):
             return False
@@ -313,4 +315,3 @@ def _mark_of(element: ET.Element) -> tuple[str, str | None] | None:
     if len(words) == 2 and words[0] in MARKED_KINDS:
         return words[0], words[1]
     return None
-
