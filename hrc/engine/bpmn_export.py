@@ -46,12 +46,9 @@ start a case with one token at each start event, whatever the places say.
 """
 
 import json
-import math
 import re
 import xml.etree.ElementTree as ET
 from collections import defaultdict
-from collections.abc import Mapping
-from dataclasses import dataclass
 from operator import itemgetter
 from typing import Any
 
@@ -62,6 +59,7 @@ from hrc.engine.bpmn import (
     DI_NAMESPACE,
     HRC_NAMESPACE,
 )
+from hrc.engine.bpmn_diagram import Drawing, Shape, Stack, point
 from hrc.engine.bpmn_marks import ARC, JOIN, MARK, MERGE, PLACE, SPLIT, TRANSITION, mark
 from hrc.engine.bpmn_net import TASK_KINDS
 from hrc.engine.document import FormatError
@@ -109,21 +107,6 @@ def _check_representable(pattern: Pattern) -> None:
     ]
     if issues:
         raise FormatError(issues)
-
-
-def _point(extra: Mapping[str, Any]) -> tuple[float, float] | None:
-    """A node's centre from its `layout`; None when it has none that is usable."""
-    layout = extra.get("layout")
-    if not isinstance(layout, dict):
-        return None
-    x, y = _number(layout.get("x")), _number(layout.get("y"))
-    return None if x is None or y is None else (x, y)
-
-
-def _number(value: object) -> float | None:
-    if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
-        return float(value)
-    return None
 
 
 def _nodes(process: Process) -> list[Place | Transition]:
@@ -176,40 +159,6 @@ def _tag(local: str, namespace: str = BPMN_NAMESPACE) -> str:
     return f"{{{namespace}}}{local}"
 
 
-@dataclass
-class _Shape:
-    element: str
-    centre: tuple[float, float]
-    size: tuple[float, float]
-
-    @property
-    def bounds(self) -> tuple[float, float, float, float]:
-        (x, y), (w, h) = self.centre, self.size
-        return x - w / 2, y - h / 2, w, h
-
-
-@dataclass
-class _Stack:
-    """Where one process' pool is drawn: its lanes' bands of the layout, stacked from `top`."""
-
-    moves: list[tuple[float, float, float]]
-    """(top in the layout, top in the pool, height) of each of its bands."""
-    lanes: dict[str | None, tuple[float, float]]
-    """Band key (an actor, or None) -> (top, height) of its lane in the pool."""
-    top: float
-    bottom: float
-
-    def y(self, y: float) -> float:
-        """A layout y moved with the band it lies in (the nearest band when it lies in none)."""
-
-        def distance(move: tuple[float, float, float]) -> float:
-            start, _, height = move
-            return max(start - y, y - (start + height), 0.0)
-
-        start, top, height = min(self.moves, key=distance)
-        return min(max(y - start + top, top), top + height)
-
-
 class _Writer:
     def __init__(self, pattern: Pattern, original: Pattern) -> None:
         self.pattern = pattern
@@ -223,15 +172,10 @@ class _Writer:
             if "layout" in node.extra
         }
         self.ids = _Ids(pattern)
-        self.shapes: list[_Shape] = []
-        self.edges: list[tuple[str, str, str]] = []
-        """(flow or association id, source element, target element)."""
-        self.message_edges: list[tuple[str, str, str]] = []
-        """The same for message flows, which cross from pool to pool."""
+        self.drawing = Drawing()
         self.element_of: dict[str, str] = {}
         """hrc task id -> the XML id of its task (constraint ends)."""
         self.process_of_task: dict[str, ET.Element] = {}
-        self.pool_lanes: list[tuple[str, tuple[float, float, float, float]]] = []
         self.messages: dict[str, str] = {}
         """Message name -> the XML id of its `<message>`."""
         self.senders: list[tuple[str, str, str]] = []
@@ -245,7 +189,7 @@ class _Writer:
             self.bands.setdefault(
                 actor if isinstance(actor, str) else None, (float(lane["y"]), float(lane["height"]))
             )
-        self.stacks: dict[str, _Stack] = {}
+        self.stacks: dict[str, Stack] = {}
         bottom = 0.0
         for process in pattern.processes:
             stack = self._stack(process, bottom)
@@ -256,7 +200,7 @@ class _Writer:
         """The layout's lane of an actor; a performer that is no actor is in the lane of None."""
         return actor_id if self.pattern.actor(actor_id) is not None else None
 
-    def _stack(self, process: Process, top: float) -> "_Stack":
+    def _stack(self, process: Process, top: float) -> Stack:
         """The process' pool from `top` down: the layout's bands of its actors, one under another.
 
         The layout shares an actor's band among the processes it works in; BPMN draws
@@ -268,11 +212,11 @@ class _Writer:
         )
         if not bands:
             ys = [
-                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
+                centre[1] for node in _nodes(process) if (centre := point(node.extra)) is not None
             ] or [0.0]
             span = (min(ys) - TASK_HEIGHT, max(ys) - min(ys) + 2 * TASK_HEIGHT)
-            return _Stack([(span[0], top, span[1])], {}, top, top + span[1])
-        stack = _Stack([], {}, top, top)
+            return Stack([(span[0], top, span[1])], {}, top, top + span[1])
+        stack = Stack([], {}, top, top)
         for (layout_top, height), key in bands:
             stack.moves.append((layout_top, stack.bottom, height))
             stack.lanes[key] = (stack.bottom, height)
@@ -322,7 +266,12 @@ class _Writer:
                 message.set("name", name)
         for element in processes:
             root.append(element)
-        self._diagram(root, collaboration.get("id", ""), pools)
+        pool_bounds = [
+            (pool, (0.0, stack.top, self.width, stack.bottom - stack.top))
+            for pool, process in pools
+            for stack in [self.stacks[process.id]]
+        ]
+        self.drawing.write(root, collaboration.get("id", ""), pool_bounds, self.ids.fresh)
         ET.indent(root)
         return (
             '<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -382,7 +331,7 @@ class _Writer:
                     targetRef=target,
                     messageRef=self.messages[name],
                 )
-                self.message_edges.append((flow_id, source, target))
+                self.drawing.message_edges.append((flow_id, source, target))
 
     def _constraints(self, collaboration: ET.Element) -> list[str | Json]:
         """Draws each constraint between two tasks; returns the constraints' order for import."""
@@ -418,76 +367,9 @@ class _Writer:
                 extra["type"] = constraint.type
             _add_extra(association, extra)
             home.append(association)
-            self.edges.append((association_id, source, target))
+            self.drawing.edges.append((association_id, source, target))
             order.append(association_id)
         return order
-
-    # The diagram.
-
-    def _diagram(self, root: ET.Element, plane_of: str, pools: list[tuple[str, Process]]) -> None:
-        diagram = ET.SubElement(
-            root, _tag("BPMNDiagram", BPMNDI_NAMESPACE), id=self.ids.fresh("diagram")
-        )
-        plane = ET.SubElement(
-            diagram,
-            _tag("BPMNPlane", BPMNDI_NAMESPACE),
-            id=self.ids.fresh("plane"),
-            bpmnElement=plane_of,
-        )
-        for pool, process in pools:
-            stack = self.stacks[process.id]
-            self._shape(
-                plane, pool, (0.0, stack.top, self.width, stack.bottom - stack.top), horizontal=True
-            )
-        for lane, bounds in self.pool_lanes:
-            self._shape(plane, lane, bounds, horizontal=True)
-        by_element = {shape.element: shape for shape in self.shapes}
-        for shape in self.shapes:
-            self._shape(plane, shape.element, shape.bounds)
-        for edge_id, source, target in self.edges:
-            edge = ET.SubElement(
-                plane,
-                _tag("BPMNEdge", BPMNDI_NAMESPACE),
-                id=self.ids.fresh(f"{edge_id}_di"),
-                bpmnElement=edge_id,
-            )
-            for x, y in _waypoints(by_element[source], by_element[target]):
-                ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
-        for edge_id, source, target in self.message_edges:
-            edge = ET.SubElement(
-                plane,
-                _tag("BPMNEdge", BPMNDI_NAMESPACE),
-                id=self.ids.fresh(f"{edge_id}_di"),
-                bpmnElement=edge_id,
-            )
-            for x, y in _message_waypoints(by_element[source], by_element[target]):
-                ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
-
-    def _shape(
-        self,
-        plane: ET.Element,
-        element: str,
-        bounds: tuple[float, float, float, float],
-        *,
-        horizontal: bool = False,
-    ) -> None:
-        shape = ET.SubElement(
-            plane,
-            _tag("BPMNShape", BPMNDI_NAMESPACE),
-            id=self.ids.fresh(f"{element}_di"),
-            bpmnElement=element,
-        )
-        if horizontal:
-            shape.set("isHorizontal", "true")
-        x, y, width, height = bounds
-        ET.SubElement(
-            shape,
-            _tag("Bounds", DC_NAMESPACE),
-            x=_num(x),
-            y=_num(y),
-            width=_num(width),
-            height=_num(height),
-        )
 
 
 def _lane_actors(process: Process) -> list[str]:
@@ -576,7 +458,7 @@ class _ProcessWriter:
         band = self.stack.lanes.get(self.writer.band_key(actor_id))
         if band is not None:
             left = POOL_HEADER_WIDTH
-            self.writer.pool_lanes.append(
+            self.writer.drawing.pool_lanes.append(
                 (xml_id, (left, band[0], self.writer.width - left, band[1]))
             )
         return lane
@@ -613,7 +495,7 @@ class _ProcessWriter:
         self.nodes.append(element)
         self.node_of[transition.id] = xml_id
         self.entry_of[transition.id] = xml_id
-        centre = _point(transition.extra) or (0.0, 0.0)
+        centre = point(transition.extra) or (0.0, 0.0)
         if transition.is_task:
             self.writer.element_of[transition.id] = xml_id
             self.writer.process_of_task[transition.id] = self.element
@@ -683,7 +565,7 @@ class _ProcessWriter:
             name = None
         producers = [self.node_of[t] for t in self.producers[place.id]]
         consumers = [self.entry_of[t] for t in self.consumers[place.id]]
-        centre = _point(place.extra) or (0.0, 0.0)
+        centre = point(place.extra) or (0.0, 0.0)
 
         def carry(element: ET.Element, faithful: bool) -> None:
             """The element that stands for the place takes its name and data."""
@@ -764,13 +646,13 @@ class _ProcessWriter:
             },
         )
         self.flows.append(flow)
-        self.writer.edges.append((flow_id, source, target))
+        self.writer.drawing.edges.append((flow_id, source, target))
         return flow
 
     def _shape(self, element: str, centre: tuple[float, float], size: tuple[float, float]) -> None:
         """A shape at its layout position, moved into the process' pool."""
         x, y = centre
-        self.writer.shapes.append(_Shape(element, (x, self.stack.y(y)), size))
+        self.writer.drawing.shapes.append(Shape(element, (x, self.stack.y(y)), size))
 
 
 def _message_name(value: object) -> str | None:
@@ -796,34 +678,3 @@ def _add_extra(element: ET.Element, data: Json, net: Json | None = None) -> None
                 value, ensure_ascii=True, sort_keys=True
             )
     element.insert(0, holder)  # extensionElements comes first in every BPMN element
-
-
-def _waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
-    """Right side to left side, bending half-way; an edge back to the left goes round below."""
-    (sx, sy), (sw, sh) = source.centre, source.size
-    (tx, ty), (tw, th) = target.centre, target.size
-    start, end = sx + sw / 2, tx - tw / 2
-    if end > start:
-        if sy == ty:
-            return [(start, sy), (end, ty)]
-        middle = (start + end) / 2
-        return [(start, sy), (middle, sy), (middle, ty), (end, ty)]
-    below = max(sy + sh / 2, ty + th / 2) + 20
-    return [(sx, sy + sh / 2), (sx, below), (tx, below), (tx, ty + th / 2)]
-
-
-def _message_waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
-    """From the sender's side facing the catcher's pool to the catcher, bending half-way."""
-    (sx, sy), (_, sh) = source.centre, source.size
-    (tx, ty), (_, th) = target.centre, target.size
-    down = ty > sy
-    start = sy + sh / 2 if down else sy - sh / 2
-    end = ty - th / 2 if down else ty + th / 2
-    if sx == tx:
-        return [(sx, start), (tx, end)]
-    middle = (start + end) / 2
-    return [(sx, start), (sx, middle), (tx, middle), (tx, end)]
-
-
-def _num(value: float) -> str:
-    return f"{value:.2f}".rstrip("0").rstrip(".")
