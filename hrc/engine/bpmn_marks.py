@@ -198,6 +198,8 @@ class _Marked:
         """XML id of each flow node -> (role, XML id of what it stands for, element)."""
         self.flows: list[tuple[str, ET.Element]] = []
         """(role, element) of each sequence flow."""
+        self.place_flows: set[str] = set()
+        """XML ids of the sequence flows that stand for a place."""
         self.places: dict[str, ET.Element] = {}
         self.transitions: dict[str, ET.Element] = {}
         """hrc id -> the element standing for it."""
@@ -220,6 +222,7 @@ class _Marked:
                     return False
                 self.flows.append((role, child))
                 if role == PLACE:
+                    self.place_flows.add(xml_id)
                     self._add(self.places, self.place_list, child)
             elif owner is not None and self._fits_node(child, local, role, owner):
                 self.nodes[xml_id] = (role, owner, child)
@@ -267,15 +270,12 @@ class _Marked:
         if role == JOIN:
             ok = self.nodes.get(owner, ("",))[0] == TRANSITION
         elif role == SPLIT:
-            ok = self.nodes.get(owner, ("",))[0] == PLACE or self._is_place_flow(owner)
+            ok = self.nodes.get(owner, ("",))[0] == PLACE or owner in self.place_flows
         elif role == MERGE:
-            ok = self._is_place_flow(owner)
+            ok = owner in self.place_flows
         else:
             ok = True
         return (role, self.reading.hrc_id(owner)) if ok else None
-
-    def _is_place_flow(self, xml_id: str) -> bool:
-        return any(role == PLACE and flow.get("id") == xml_id for role, flow in self.flows)
 
     def _arcs(self) -> list[tuple[str, str]] | None:
         arcs: list[tuple[str, str]] = []
