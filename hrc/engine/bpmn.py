@@ -55,16 +55,24 @@ and conversations. Nothing else is read from the file, so a refused import
 creates nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the
 pattern in its actors' lanes.
 
-Exclusive gateways choose when they are reached (BPMN's data-based choice),
-not when a task starts: a round trip through `pattern_to_bpmn` keeps the tasks,
-actors, constraints and every sequence of task starts and completions, but a
-choice between two tasks is then made by a silent step just before them.
+hrc's own exports are not mapped: a process whose elements all carry the
+`hrc:net` marks `bpmn_export` writes, still consistent with its `<hrc:net>`,
+is rebuilt from them exactly as it was exported (ids, places, arcs, order,
+layout; names, lanes and task kinds as the file now says), see `bpmn_marks`;
+the collaboration's `<hrc:extra>` restores the order of actors and
+constraints. A process edited in another tool so that a mark is missing or no
+longer fits (a task or flow added or removed, a flow reconnected) is read by
+the mapping above, and then the document keeps no layout. Through the mapping,
+exclusive gateways choose when they are reached (BPMN's data-based choice),
+not when a task starts: the tasks, actors, constraints and every sequence of
+task starts and completions stay, but a choice between two tasks is made by a
+silent step just before them.
 """
 
 import json
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from io import BytesIO
 from typing import Any, cast
 
@@ -75,9 +83,10 @@ from defusedxml.ElementTree import (  # type: ignore[import-untyped, unused-igno
     iterparse as _safe_iterparse,
 )
 
+from hrc.engine.bpmn_marks import exported_net
 from hrc.engine.bpmn_net import FlowNet, Scope, describe
 from hrc.engine.bpmn_scopes import FLOW_NODE_KINDS, GLOBAL_TASKS, ProcessGraph, ProcessReader
-from hrc.engine.bpmn_xml import BPMN_NAMESPACE, HRC_NAMESPACE
+from hrc.engine.bpmn_xml import BPMN_NAMESPACE, HRC_NAMESPACE, all_lanes
 from hrc.engine.bpmn_xml import bpmn_name as _bpmn
 from hrc.engine.bpmn_xml import children as _children
 from hrc.engine.bpmn_xml import hrc_attribute as _hrc
@@ -207,6 +216,10 @@ class _Importer:
         self.constraints: list[Json] = []
         self.hrc_ids: dict[str, str] = {}
         """XML id -> hrc id of every element that has one."""
+        self.drawn_constraints: dict[str, Json] = {}
+        """XML id of each constraint's association -> the constraint."""
+        self.mapped = False
+        """Whether some process was read through the mapping rather than from its marks."""
 
     def fail(self, message: str, *elements: str) -> None:
         self.issues.append(error("format", message, *elements))
@@ -227,11 +240,14 @@ class _Importer:
         if declared is not None:
             document["declared_pattern"] = declared
         order: list[object] = []
+        constraint_order: list[object] = []
         for collaboration in collaborations:
             extra = self._extra(collaboration, f"collaboration {collaboration.get('id')}")
-            # Our export lists the actors' ids here, in the document's order.
-            listed = extra.pop("actors", [])
-            order += listed if isinstance(listed, list) else []
+            # Our export lists the actors and constraints here, in the document's order: an
+            # actor without a lane and a constraint without an association in full.
+            for key, listed in (("actors", order), ("constraints", constraint_order)):
+                given = extra.pop(key, [])
+                listed += given if isinstance(given, list) else []
             document.update(extra)
         built = [self._process(p, participants.get(p.get("id", ""))) for p in processes]
         for container in [*processes, *collaborations]:
@@ -252,13 +268,36 @@ class _Importer:
         given = document.get("data", {})
         if self.data and isinstance(given, dict):
             document["data"] = {**self.data, **given}
-        rank = {actor_id: index for index, actor_id in reversed(list(enumerate(order)))}
-        document["actors"] = sorted(
-            self.actors.values(), key=lambda actor: rank.get(actor["id"], len(rank))
-        )
+        if self.mapped:
+            document.pop("layout", None)  # the mapped processes' nodes have no position
+        document["actors"] = self._ordered_actors(order)
         document["processes"] = built
-        document["constraints"] = self.constraints
+        document["constraints"] = self._ordered_constraints(constraint_order)
         return document
+
+    def _ordered_actors(self, order: list[object]) -> list[Json]:
+        """The actors in the order the export listed them, adding those it gave in full."""
+        ids: list[object] = []
+        for entry in order:
+            if isinstance(entry, dict) and isinstance(entry.get("id"), str):
+                self.actors.setdefault(entry["id"], entry)
+                ids.append(entry["id"])
+            else:
+                ids.append(entry)
+        rank = {actor_id: index for index, actor_id in reversed(list(enumerate(ids)))}
+        return sorted(self.actors.values(), key=lambda actor: rank.get(actor["id"], len(rank)))
+
+    def _ordered_constraints(self, order: list[object]) -> list[Json]:
+        """The constraints in the order the export listed them (an association's id, or the
+        constraint in full), then those it did not list."""
+        listed: list[Json] = []
+        for entry in order:
+            if isinstance(entry, dict):
+                listed.append(entry)
+            elif isinstance(entry, str) and entry in self.drawn_constraints:
+                listed.append(self.drawn_constraints.pop(entry))
+        taken = {id(constraint) for constraint in listed}
+        return listed + [c for c in self.constraints if id(c) not in taken]
 
     # Ids.
 
@@ -419,6 +458,10 @@ class _Importer:
     # One process.
 
     def _process(self, element: ET.Element, pool: ET.Element | None) -> Json:
+        exported = exported_net(element, self)
+        if exported is not None:
+            return exported
+        self.mapped = True
         process_xml_id = element.get("id", "")
         if not process_xml_id:
             self.fail("A <process> has no id; BPMN needs one on every process.")
@@ -560,6 +603,12 @@ class _Importer:
     def signal_thrown(self, name: str) -> bool:
         return name in self.signals_thrown
 
+    def performer(self, lane: ET.Element) -> str:
+        """The actor a lane declares with hrc:actorType, else the performer id it stands for."""
+        if _hrc(lane, "actorType") is not None:
+            return self._actor(lane, f"lane {lane.get('id')}")
+        return self.hrc_id(lane.get("id", ""))
+
     def event_definition(self, xml_id: str) -> ET.Element | None:
         element = self.elements.get(xml_id)
         local = _bpmn(element) if element is not None else None
@@ -582,11 +631,11 @@ class _Importer:
         """
         lane_of: dict[str, ET.Element] = {}
         # A called process' own lanes count for the tasks inlined from it.
-        lanes = list(self._all_lanes(process)) + [
+        lanes = list(all_lanes(process)) + [
             lane
             for other in self.processes.values()
             if other is not process
-            for lane in self._all_lanes(other)
+            for lane in all_lanes(other)
         ]
         for lane in lanes:  # outer lanes first, so an inner lane overrides
             for reference in _children(lane, "flowNodeRef"):
@@ -603,15 +652,6 @@ class _Importer:
                 default = default or self._default_actor(process_id, process.get("name"))
                 performers[task_id] = default
         return performers
-
-    def _all_lanes(self, container: ET.Element) -> Iterator[ET.Element]:
-        """Every lane under the container's lane sets, outer before inner."""
-        stack = list(reversed(_children(container, "laneSet")))
-        while stack:
-            lane_set = stack.pop()
-            for lane in _children(lane_set, "lane"):
-                yield lane
-                stack.extend(reversed(_children(lane, "childLaneSet")))
 
     def _actor(self, element: ET.Element, where: str) -> str:
         """The actor a lane or pool stands for, added on first use; returns its id."""
@@ -664,3 +704,4 @@ class _Importer:
             extra = self._extra(association, f"association {xml_id}")
             constraint.update({k: v for k, v in extra.items() if k != "id"})
             self.constraints.append(constraint)
+            self.drawn_constraints[xml_id] = constraint

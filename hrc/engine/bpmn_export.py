@@ -27,6 +27,18 @@ Positions come from the document's `layout` (`layout.lay_out` when it has
 none): tasks, gateways and events at their nodes' centres, pools and lanes as
 the layout's lane bands.
 
+The import gives the same document back, not only the same behaviour: each
+element written carries an `hrc:net` attribute saying what it stands for in
+the net (`transition t1`, `place p2`, the `join`, `split` or `merge` of one, an
+`arc`), and each process an `<hrc:net>` with its actors, its ids and arcs in
+order, and its nodes' layout as given (none when the pattern had none); the
+collaboration's `<hrc:extra>` orders the actors and constraints and gives in
+full those BPMN cannot draw (an actor in no process, a constraint on a silent
+step). `bpmn_marks` says how the import checks and reads them; a process
+edited in another tool so that its marks no longer hold is read by the mapping.
+Both are attributes and elements of the hrc namespace, which OMG's XSD allows
+on every BPMN element.
+
 A net BPMN cannot draw is refused with a FormatError naming the elements:
 duplicate ids, and arcs to unknown nodes or between two places or two
 transitions. Initial tokens travel in `<hrc:extra>` like the rest; other tools
@@ -34,12 +46,9 @@ start a case with one token at each start event, whatever the places say.
 """
 
 import json
-import math
 import re
 import xml.etree.ElementTree as ET
 from collections import defaultdict
-from collections.abc import Mapping
-from dataclasses import dataclass
 from operator import itemgetter
 from typing import Any
 
@@ -50,6 +59,8 @@ from hrc.engine.bpmn import (
     DI_NAMESPACE,
     HRC_NAMESPACE,
 )
+from hrc.engine.bpmn_diagram import Drawing, Shape, Stack, point
+from hrc.engine.bpmn_marks import ARC, JOIN, MARK, MERGE, PLACE, SPLIT, TRANSITION, mark
 from hrc.engine.bpmn_net import TASK_KINDS
 from hrc.engine.document import FormatError
 from hrc.engine.issues import error
@@ -84,9 +95,8 @@ UNREPRESENTABLE = ("duplicate-id", "unknown-node", "arc-kind")
 def pattern_to_bpmn(pattern: Pattern) -> str:
     """The BPMN 2.0 XML of a pattern; raises FormatError when BPMN cannot represent it."""
     _check_representable(pattern)
-    if not is_laid_out(pattern):
-        pattern = lay_out_pattern(pattern)
-    return _Writer(pattern).text()
+    drawn = pattern if is_laid_out(pattern) else lay_out_pattern(pattern)
+    return _Writer(drawn, pattern).text()
 
 
 def _check_representable(pattern: Pattern) -> None:
@@ -97,21 +107,6 @@ def _check_representable(pattern: Pattern) -> None:
     ]
     if issues:
         raise FormatError(issues)
-
-
-def _point(extra: Mapping[str, Any]) -> tuple[float, float] | None:
-    """A node's centre from its `layout`; None when it has none that is usable."""
-    layout = extra.get("layout")
-    if not isinstance(layout, dict):
-        return None
-    x, y = _number(layout.get("x")), _number(layout.get("y"))
-    return None if x is None or y is None else (x, y)
-
-
-def _number(value: object) -> float | None:
-    if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
-        return float(value)
-    return None
 
 
 def _nodes(process: Process) -> list[Place | Transition]:
@@ -164,53 +159,23 @@ def _tag(local: str, namespace: str = BPMN_NAMESPACE) -> str:
     return f"{{{namespace}}}{local}"
 
 
-@dataclass
-class _Shape:
-    element: str
-    centre: tuple[float, float]
-    size: tuple[float, float]
-
-    @property
-    def bounds(self) -> tuple[float, float, float, float]:
-        (x, y), (w, h) = self.centre, self.size
-        return x - w / 2, y - h / 2, w, h
-
-
-@dataclass
-class _Stack:
-    """Where one process' pool is drawn: its lanes' bands of the layout, stacked from `top`."""
-
-    moves: list[tuple[float, float, float]]
-    """(top in the layout, top in the pool, height) of each of its bands."""
-    lanes: dict[str | None, tuple[float, float]]
-    """Band key (an actor, or None) -> (top, height) of its lane in the pool."""
-    top: float
-    bottom: float
-
-    def y(self, y: float) -> float:
-        """A layout y moved with the band it lies in (the nearest band when it lies in none)."""
-
-        def distance(move: tuple[float, float, float]) -> float:
-            start, _, height = move
-            return max(start - y, y - (start + height), 0.0)
-
-        start, top, height = min(self.moves, key=distance)
-        return min(max(y - start + top, top), top + height)
-
-
 class _Writer:
-    def __init__(self, pattern: Pattern) -> None:
+    def __init__(self, pattern: Pattern, original: Pattern) -> None:
         self.pattern = pattern
+        """The pattern laid out, for the diagram."""
+        self.original = original
+        """The pattern as given, whose layout (or lack of it) the marks keep."""
+        self.layouts: dict[str, Any] = {
+            node.id: node.extra["layout"]
+            for process in original.processes
+            for node in _nodes(process)
+            if "layout" in node.extra
+        }
         self.ids = _Ids(pattern)
-        self.shapes: list[_Shape] = []
-        self.edges: list[tuple[str, str, str]] = []
-        """(flow or association id, source element, target element)."""
-        self.message_edges: list[tuple[str, str, str]] = []
-        """The same for message flows, which cross from pool to pool."""
+        self.drawing = Drawing()
         self.element_of: dict[str, str] = {}
         """hrc task id -> the XML id of its task (constraint ends)."""
         self.process_of_task: dict[str, ET.Element] = {}
-        self.pool_lanes: list[tuple[str, tuple[float, float, float, float]]] = []
         self.messages: dict[str, str] = {}
         """Message name -> the XML id of its `<message>`."""
         self.senders: list[tuple[str, str, str]] = []
@@ -224,7 +189,7 @@ class _Writer:
             self.bands.setdefault(
                 actor if isinstance(actor, str) else None, (float(lane["y"]), float(lane["height"]))
             )
-        self.stacks: dict[str, _Stack] = {}
+        self.stacks: dict[str, Stack] = {}
         bottom = 0.0
         for process in pattern.processes:
             stack = self._stack(process, bottom)
@@ -235,7 +200,7 @@ class _Writer:
         """The layout's lane of an actor; a performer that is no actor is in the lane of None."""
         return actor_id if self.pattern.actor(actor_id) is not None else None
 
-    def _stack(self, process: Process, top: float) -> "_Stack":
+    def _stack(self, process: Process, top: float) -> Stack:
         """The process' pool from `top` down: the layout's bands of its actors, one under another.
 
         The layout shares an actor's band among the processes it works in; BPMN draws
@@ -247,11 +212,11 @@ class _Writer:
         )
         if not bands:
             ys = [
-                point[1] for node in _nodes(process) if (point := _point(node.extra)) is not None
+                centre[1] for node in _nodes(process) if (centre := point(node.extra)) is not None
             ] or [0.0]
             span = (min(ys) - TASK_HEIGHT, max(ys) - min(ys) + 2 * TASK_HEIGHT)
-            return _Stack([(span[0], top, span[1])], {}, top, top + span[1])
-        stack = _Stack([], {}, top, top)
+            return Stack([(span[0], top, span[1])], {}, top, top + span[1])
+        stack = Stack([], {}, top, top)
         for (layout_top, height), key in bands:
             stack.moves.append((layout_top, stack.bottom, height))
             stack.lanes[key] = (stack.bottom, height)
@@ -269,34 +234,44 @@ class _Writer:
                 "exporterVersion": "1",
             },
         )
-        document_extra: Json = {k: v for k, v in pattern.extra.items() if k != "layout"}
-        if _is_text(pattern.name):
+        document_extra: Json = dict(self.original.extra)
+        if pattern.name and _is_text(pattern.name):
             root.set("name", pattern.name)
-        else:
-            document_extra["name"] = pattern.name
+        if not (pattern.name and _is_text(pattern.name) and pattern.name == pattern.name.strip()):
+            document_extra["name"] = pattern.name  # the importer strips names and needs one
         if pattern.declared_pattern is not None:
             root.set(_tag("declaredPattern", HRC_NAMESPACE), pattern.declared_pattern)
         collaboration = ET.SubElement(
             root, _tag("collaboration"), id=self.ids.fresh("collaboration")
         )
-        # The actors' order (the editor's lanes); import sorts the lanes' actors by it.
-        document_extra["actors"] = [actor.id for actor in pattern.actors]
-        _add_extra(collaboration, document_extra)
+        # The actors' and constraints' order, which import restores; an actor without a lane
+        # and a constraint without an association are given in full.
+        laned = {actor for process in pattern.processes for actor in _lane_actors(process)}
+        document_extra["actors"] = [
+            actor.id if actor.id in laned else {"id": actor.id, "type": actor.type, **actor.extra}
+            for actor in pattern.actors
+        ]
         processes = []
         pools: list[tuple[str, Process]] = []
         for process in pattern.processes:
             element, pool = self._process(process, collaboration)
             processes.append(element)
             pools.append((pool, process))
+        self._message_flows(collaboration)
+        document_extra["constraints"] = self._constraints(collaboration)
+        _add_extra(collaboration, document_extra)
         for name, message_id in self.messages.items():
             message = ET.SubElement(root, _tag("message"), id=message_id)
             if _is_text(name):
                 message.set("name", name)
         for element in processes:
             root.append(element)
-        self._message_flows(collaboration)
-        self._constraints(collaboration)
-        self._diagram(root, collaboration.get("id", ""), pools)
+        pool_bounds = [
+            (pool, (0.0, stack.top, self.width, stack.bottom - stack.top))
+            for pool, process in pools
+            for stack in [self.stacks[process.id]]
+        ]
+        self.drawing.write(root, collaboration.get("id", ""), pool_bounds, self.ids.fresh)
         ET.indent(root)
         return (
             '<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -309,11 +284,11 @@ class _Writer:
     def _process(self, process: Process, collaboration: ET.Element) -> tuple[ET.Element, str]:
         xml_id, faithful = self.ids.own(process.id, "process")
         element = ET.Element(_tag("process"), id=xml_id, isExecutable="false")
-        extra: Json = {k: v for k, v in process.extra.items() if k != "layout"}
+        extra: Json = dict(process.extra)
         if not faithful:
             extra["id"] = process.id
         name = extra.get("name")
-        if isinstance(name, str) and _is_text(name):
+        if isinstance(name, str) and name and _is_text(name):
             element.set("name", name)
             del extra["name"]
         if process.workpiece is not None:
@@ -321,7 +296,14 @@ class _Writer:
                 element.set(_tag("workpiece", HRC_NAMESPACE), process.workpiece)
             else:
                 extra["workpiece"] = process.workpiece
-        _add_extra(element, extra)
+        net = {
+            "actors": list(process.actors),
+            "places": [place.id for place in process.places],
+            "transitions": [transition.id for transition in process.transitions],
+            "arcs": [list(arc) for arc in process.arcs],
+            "layout": {n.id: self.layouts[n.id] for n in _nodes(process) if n.id in self.layouts},
+        }
+        _add_extra(element, extra, net)
         pool = self.ids.fresh(f"{xml_id}_pool")
         participant = ET.SubElement(collaboration, _tag("participant"), id=pool, processRef=xml_id)
         participant.set("name", element.get("name") or xml_id)
@@ -349,14 +331,25 @@ class _Writer:
                     targetRef=target,
                     messageRef=self.messages[name],
                 )
-                self.message_edges.append((flow_id, source, target))
+                self.drawing.message_edges.append((flow_id, source, target))
 
-    def _constraints(self, collaboration: ET.Element) -> None:
+    def _constraints(self, collaboration: ET.Element) -> list[str | Json]:
+        """Draws each constraint between two tasks; returns the constraints' order for import."""
+        order: list[str | Json] = []
         for constraint in self.pattern.constraints:
             source = self.element_of.get(constraint.source)
             target = self.element_of.get(constraint.target)
             if source is None or target is None:
-                continue  # a constraint on a silent step: the rules report it, BPMN has no place for it
+                # A constraint on a silent step: the rules report it, BPMN has no place for it.
+                order.append(
+                    {
+                        "from": constraint.source,
+                        "to": constraint.target,
+                        "type": constraint.type,
+                        **constraint.extra,
+                    }
+                )
+                continue
             home = self.process_of_task.get(constraint.source, collaboration)
             association_id = self.ids.fresh(f"{constraint.type}_{source}_{target}")
             association = ET.Element(
@@ -374,74 +367,9 @@ class _Writer:
                 extra["type"] = constraint.type
             _add_extra(association, extra)
             home.append(association)
-            self.edges.append((association_id, source, target))
-
-    # The diagram.
-
-    def _diagram(self, root: ET.Element, plane_of: str, pools: list[tuple[str, Process]]) -> None:
-        diagram = ET.SubElement(
-            root, _tag("BPMNDiagram", BPMNDI_NAMESPACE), id=self.ids.fresh("diagram")
-        )
-        plane = ET.SubElement(
-            diagram,
-            _tag("BPMNPlane", BPMNDI_NAMESPACE),
-            id=self.ids.fresh("plane"),
-            bpmnElement=plane_of,
-        )
-        for pool, process in pools:
-            stack = self.stacks[process.id]
-            self._shape(
-                plane, pool, (0.0, stack.top, self.width, stack.bottom - stack.top), horizontal=True
-            )
-        for lane, bounds in self.pool_lanes:
-            self._shape(plane, lane, bounds, horizontal=True)
-        by_element = {shape.element: shape for shape in self.shapes}
-        for shape in self.shapes:
-            self._shape(plane, shape.element, shape.bounds)
-        for edge_id, source, target in self.edges:
-            edge = ET.SubElement(
-                plane,
-                _tag("BPMNEdge", BPMNDI_NAMESPACE),
-                id=self.ids.fresh(f"{edge_id}_di"),
-                bpmnElement=edge_id,
-            )
-            for x, y in _waypoints(by_element[source], by_element[target]):
-                ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
-        for edge_id, source, target in self.message_edges:
-            edge = ET.SubElement(
-                plane,
-                _tag("BPMNEdge", BPMNDI_NAMESPACE),
-                id=self.ids.fresh(f"{edge_id}_di"),
-                bpmnElement=edge_id,
-            )
-            for x, y in _message_waypoints(by_element[source], by_element[target]):
-                ET.SubElement(edge, _tag("waypoint", DI_NAMESPACE), x=_num(x), y=_num(y))
-
-    def _shape(
-        self,
-        plane: ET.Element,
-        element: str,
-        bounds: tuple[float, float, float, float],
-        *,
-        horizontal: bool = False,
-    ) -> None:
-        shape = ET.SubElement(
-            plane,
-            _tag("BPMNShape", BPMNDI_NAMESPACE),
-            id=self.ids.fresh(f"{element}_di"),
-            bpmnElement=element,
-        )
-        if horizontal:
-            shape.set("isHorizontal", "true")
-        x, y, width, height = bounds
-        ET.SubElement(
-            shape,
-            _tag("Bounds", DC_NAMESPACE),
-            x=_num(x),
-            y=_num(y),
-            width=_num(width),
-            height=_num(height),
-        )
+            self.drawing.edges.append((association_id, source, target))
+            order.append(association_id)
+        return order
 
 
 def _lane_actors(process: Process) -> list[str]:
@@ -518,18 +446,19 @@ class _ProcessWriter:
         if not faithful:
             extra["id"] = actor_id
         name = extra.pop("name", None)
-        if not (isinstance(name, str) and name and _is_text(name)):
+        if not (isinstance(name, str) and name and _is_text(name)) or name == actor_id:
             if name is not None:
-                extra["name"] = name
-            name = actor_id if _is_text(actor_id) else xml_id
-        lane.set("name", name)
+                extra["name"] = name  # import takes a lane named as its actor for unnamed
+            name = actor_id if _is_text(actor_id) else None
+        if name is not None:
+            lane.set("name", name)
         if actor is not None:
             lane.set(_tag("actorType", HRC_NAMESPACE), actor.type)
         _add_extra(lane, extra)
         band = self.stack.lanes.get(self.writer.band_key(actor_id))
         if band is not None:
             left = POOL_HEADER_WIDTH
-            self.writer.pool_lanes.append(
+            self.writer.drawing.pool_lanes.append(
                 (xml_id, (left, band[0], self.writer.width - left, band[1]))
             )
         return lane
@@ -540,10 +469,10 @@ class _ProcessWriter:
         extra: Json = {k: v for k, v in transition.extra.items() if k != "layout"}
         kind = "parallelGateway"
         if transition.is_task:
-            wanted = extra.pop("bpmn", "task")
+            wanted = extra.get("bpmn", "task")
             kind = wanted if wanted in TASK_KINDS else "task"
-            if wanted not in TASK_KINDS:
-                extra["bpmn"] = wanted
+            if kind != "task":
+                del extra["bpmn"]  # the element's kind says it
         xml_id, faithful = self.ids.own(transition.id, "transition")
         if not faithful:
             extra["id"] = transition.id
@@ -553,7 +482,9 @@ class _ProcessWriter:
             self.definitions[xml_id] = definition
             if kind == "intermediateCatchEvent":
                 self.catching.add(xml_id)
-        element = ET.Element(_tag(kind), id=xml_id)
+        element = ET.Element(
+            _tag(kind), {"id": xml_id, _tag(MARK, HRC_NAMESPACE): mark(TRANSITION, xml_id)}
+        )
         label = transition.label
         if label is not None:
             if label and _is_text(label):
@@ -564,7 +495,7 @@ class _ProcessWriter:
         self.nodes.append(element)
         self.node_of[transition.id] = xml_id
         self.entry_of[transition.id] = xml_id
-        centre = _point(transition.extra) or (0.0, 0.0)
+        centre = point(transition.extra) or (0.0, 0.0)
         if transition.is_task:
             self.writer.element_of[transition.id] = xml_id
             self.writer.process_of_task[transition.id] = self.element
@@ -580,7 +511,7 @@ class _ProcessWriter:
         if len(self.inputs[transition.id]) > 1 and kind != "parallelGateway":
             # BPMN merges flows into a task or an event; the net's transition waits for all its inputs.
             join = self.ids.fresh(f"{xml_id}_join")
-            self.nodes.append(ET.Element(_tag("parallelGateway"), id=join))
+            self._node("parallelGateway", join, mark(JOIN, xml_id))
             width = TASK_WIDTH if transition.is_task else EVENT_SIZE
             left = centre[0] - width / 2 - JOIN_SIZE / 2 - 2
             self._shape(join, (left, centre[1]), (JOIN_SIZE, JOIN_SIZE))
@@ -634,7 +565,7 @@ class _ProcessWriter:
             name = None
         producers = [self.node_of[t] for t in self.producers[place.id]]
         consumers = [self.entry_of[t] for t in self.consumers[place.id]]
-        centre = _point(place.extra) or (0.0, 0.0)
+        centre = point(place.extra) or (0.0, 0.0)
 
         def carry(element: ET.Element, faithful: bool) -> None:
             """The element that stands for the place takes its name and data."""
@@ -645,11 +576,11 @@ class _ProcessWriter:
 
         if not producers:
             event, faithful = self.ids.own(place.id, f"{place.id}_start")
-            start = self._node("startEvent", event)
+            start = self._node("startEvent", event, mark(PLACE, event))
             carry(start, faithful)
             if len(consumers) > 1:
                 split = self.ids.fresh(f"{event}_split")
-                self._node(self._choice(consumers), split)
+                self._node(self._choice(consumers), split, mark(SPLIT, event))
                 self._shape(event, (centre[0] - 25, centre[1]), (EVENT_SIZE, EVENT_SIZE))
                 self._shape(split, (centre[0] + 25, centre[1]), (GATEWAY_SIZE, GATEWAY_SIZE))
                 self._flow(event, split)
@@ -661,7 +592,7 @@ class _ProcessWriter:
                     self._flow(event, consumer)
         elif not consumers:
             event, faithful = self.ids.own(place.id, f"{place.id}_end")
-            carry(self._node("endEvent", event), faithful)
+            carry(self._node("endEvent", event, mark(PLACE, event)), faithful)
             self._shape(event, centre, (EVENT_SIZE, EVENT_SIZE))
             for producer in producers:
                 self._flow(producer, event)
@@ -670,23 +601,23 @@ class _ProcessWriter:
             carry(self._flow(producers[0], consumers[0], flow_id), faithful)
         elif len(producers) == 1:  # a choice: the flow into the gateway is the place
             split = self.ids.fresh(f"{place.id}_split")
-            self._node(self._choice(consumers), split)
-            self._shape(split, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            self._node(self._choice(consumers), split, mark(SPLIT, flow_id))
+            self._shape(split, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             carry(self._flow(producers[0], split, flow_id), faithful)
             for consumer in consumers:
                 self._flow(split, consumer)
         elif len(consumers) == 1:  # a merge: the flow out of the gateway is the place
             merge = self.ids.fresh(f"{place.id}_merge")
-            self._node("exclusiveGateway", merge)
+            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
+            self._node("exclusiveGateway", merge, mark(MERGE, flow_id))
             self._shape(merge, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             for producer in producers:
                 self._flow(producer, merge)
-            flow_id, faithful = self.ids.own(place.id, f"{place.id}_flow")
             carry(self._flow(merge, consumers[0], flow_id), faithful)
         else:
             gateway, faithful = self.ids.own(place.id, f"{place.id}_gateway")
-            carry(self._node(self._choice(consumers), gateway), faithful)
+            carry(self._node(self._choice(consumers), gateway, mark(PLACE, gateway)), faithful)
             self._shape(gateway, centre, (GATEWAY_SIZE, GATEWAY_SIZE))
             for producer in producers:
                 self._flow(producer, gateway)
@@ -697,22 +628,31 @@ class _ProcessWriter:
         """The gateway of a place's choice: event-based when every branch waits for an event."""
         return "eventBasedGateway" if set(consumers) <= self.catching else "exclusiveGateway"
 
-    def _node(self, kind: str, xml_id: str) -> ET.Element:
-        element = ET.Element(_tag(kind), id=xml_id)
+    def _node(self, kind: str, xml_id: str, stands_for: str) -> ET.Element:
+        element = ET.Element(_tag(kind), {"id": xml_id, _tag(MARK, HRC_NAMESPACE): stands_for})
         self.nodes.append(element)
         return element
 
-    def _flow(self, source: str, target: str, flow_id: str | None = None) -> ET.Element:
-        flow_id = flow_id or self.ids.fresh(f"flow_{source}_{target}")
-        flow = ET.Element(_tag("sequenceFlow"), id=flow_id, sourceRef=source, targetRef=target)
+    def _flow(self, source: str, target: str, place: str | None = None) -> ET.Element:
+        """A sequence flow: the place of that XML id, or an arc between what its ends stand for."""
+        flow_id = place or self.ids.fresh(f"flow_{source}_{target}")
+        flow = ET.Element(
+            _tag("sequenceFlow"),
+            {
+                "id": flow_id,
+                _tag(MARK, HRC_NAMESPACE): mark(PLACE, place) if place else mark(ARC),
+                "sourceRef": source,
+                "targetRef": target,
+            },
+        )
         self.flows.append(flow)
-        self.writer.edges.append((flow_id, source, target))
+        self.writer.drawing.edges.append((flow_id, source, target))
         return flow
 
     def _shape(self, element: str, centre: tuple[float, float], size: tuple[float, float]) -> None:
         """A shape at its layout position, moved into the process' pool."""
         x, y = centre
-        self.writer.shapes.append(_Shape(element, (x, self.stack.y(y)), size))
+        self.writer.drawing.shapes.append(Shape(element, (x, self.stack.y(y)), size))
 
 
 def _message_name(value: object) -> str | None:
@@ -723,46 +663,18 @@ def _message_name(value: object) -> str | None:
     return name if isinstance(name, str) and name else None
 
 
-def _add_extra(element: ET.Element, data: Json) -> None:
-    """The keys BPMN cannot carry, as JSON in `<extensionElements><hrc:extra>`.
+def _add_extra(element: ET.Element, data: Json, net: Json | None = None) -> None:
+    """The keys BPMN cannot carry, as JSON in `<extensionElements><hrc:extra>`, and a
+    process' `<hrc:net>` (`bpmn_marks`).
 
     ASCII-escaped JSON, so any string (even one XML cannot hold) survives.
     """
-    if not data:
+    if not data and net is None:
         return
     holder = ET.Element(_tag("extensionElements"))
-    ET.SubElement(holder, _tag("extra", HRC_NAMESPACE)).text = json.dumps(
-        data, ensure_ascii=True, sort_keys=True
-    )
+    for local, value in (("extra", data or None), (MARK, net)):
+        if value is not None:
+            ET.SubElement(holder, _tag(local, HRC_NAMESPACE)).text = json.dumps(
+                value, ensure_ascii=True, sort_keys=True
+            )
     element.insert(0, holder)  # extensionElements comes first in every BPMN element
-
-
-def _waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
-    """Right side to left side, bending half-way; an edge back to the left goes round below."""
-    (sx, sy), (sw, sh) = source.centre, source.size
-    (tx, ty), (tw, th) = target.centre, target.size
-    start, end = sx + sw / 2, tx - tw / 2
-    if end > start:
-        if sy == ty:
-            return [(start, sy), (end, ty)]
-        middle = (start + end) / 2
-        return [(start, sy), (middle, sy), (middle, ty), (end, ty)]
-    below = max(sy + sh / 2, ty + th / 2) + 20
-    return [(sx, sy + sh / 2), (sx, below), (tx, below), (tx, ty + th / 2)]
-
-
-def _message_waypoints(source: _Shape, target: _Shape) -> list[tuple[float, float]]:
-    """From the sender's side facing the catcher's pool to the catcher, bending half-way."""
-    (sx, sy), (_, sh) = source.centre, source.size
-    (tx, ty), (_, th) = target.centre, target.size
-    down = ty > sy
-    start = sy + sh / 2 if down else sy - sh / 2
-    end = ty - th / 2 if down else ty + th / 2
-    if sx == tx:
-        return [(sx, start), (tx, end)]
-    middle = (start + end) / 2
-    return [(sx, start), (sx, middle), (tx, middle), (tx, end)]
-
-
-def _num(value: float) -> str:
-    return f"{value:.2f}".rstrip("0").rstrip(".")

@@ -1,6 +1,7 @@
 """Namespaces and element helpers shared by the BPMN reader's modules."""
 
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 
 BPMN_NAMESPACE = "http://www.omg.org/spec/BPMN/20100524/MODEL"
 HRC_NAMESPACE = "urn:hrc:bpmn:1"
@@ -36,3 +37,13 @@ def text_of(element: ET.Element | None) -> str:
 
 def hrc_attribute(element: ET.Element, name: str) -> str | None:
     return element.get(f"{{{HRC_NAMESPACE}}}{name}")
+
+
+def all_lanes(container: ET.Element) -> Iterator[ET.Element]:
+    """Every lane under the container's lane sets, outer before inner."""
+    stack = list(reversed(children(container, "laneSet")))
+    while stack:
+        lane_set = stack.pop()
+        for lane in children(lane_set, "lane"):
+            yield lane
+            stack.extend(reversed(children(lane, "childLaneSet")))

@@ -4,9 +4,15 @@ The schema is OMG's BPMN 2.0 XSD (BPMN20.xsd with Semantic.xsd, BPMNDI.xsd,
 DC.xsd and DI.xsd), as SpiffWorkflow ships it. The exports checked are the
 example library, the use cases, the shared examples beside the checkout, and a
 model with the keys of timers, cancellation, messages between pools and
-guards. Round trip: each task, and each silent transition that carries
-configuration (timer, cancels, message, send, guard, rewrite), comes back with
-its id, performer, label and keys; what `cancels` names is still there.
+guards.
+
+Round trip: an export imports back as the same document, every key, id, order
+and position included (`bpmn_marks`). Edited in another tool (a task added,
+its marks missing), a process is read by BPMN's mapping instead, which keeps
+the edit; the mapping alone, with every mark removed, gives back each task and
+each silent transition that carries configuration (timer, cancels, message,
+send, guard, rewrite) with its id, performer, label and keys, and what
+`cancels` names is still there.
 """
 
 import itertools
@@ -21,13 +27,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lxml import etree
 
-from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
+from hrc.engine.bpmn import BPMN_NAMESPACE, HRC_NAMESPACE, bpmn_to_pattern
 from hrc.engine.bpmn_export import pattern_to_bpmn
 from hrc.engine.check import check_pattern
-from hrc.engine.document import read_pattern
+from hrc.engine.document import read_pattern, write_pattern
+from hrc.engine.layout import lay_out_pattern
 from hrc.engine.model import Pattern, Process
 from tests.engine.builders import EXAMPLES, document, process
-from tests.engine.strategies import decorated, patterns
+from tests.engine.strategies import cancelling, decorated, patterns
 
 ROOT = Path(__file__).resolve().parents[2]
 # Beside the checkout in CI (../shared); a worktree sits one level deeper.
@@ -133,6 +140,36 @@ def test_the_schema_refuses_what_bpmn_does_not_allow() -> None:
 # Round trip ------------------------------------------------------------------------------
 
 
+def unmarked(text: str) -> str:
+    """The export without the marks that tell hrc what each element stands for, as a tool that
+    drops attributes and extension elements it does not know would save it."""
+    root = etree.fromstring(text.encode())
+    for element in root.iter():
+        element.attrib.pop(f"{{{HRC_NAMESPACE}}}net", None)
+    for net in root.iter(f"{{{HRC_NAMESPACE}}}net"):
+        net.getparent().remove(net)
+    return str(etree.tostring(root, encoding="unicode"))
+
+
+def assert_unchanged(pattern: Pattern, text: str | None = None) -> Pattern:
+    back = bpmn_to_pattern(text or pattern_to_bpmn(pattern))
+    assert write_pattern(back) == write_pattern(pattern)
+    return back
+
+
+@pytest.mark.parametrize("data", _library())
+def test_every_export_imports_back_unchanged(data: dict[str, Any]) -> None:
+    assert_unchanged(read_pattern(data))
+
+
+def test_the_marks_are_what_brings_it_back_unchanged() -> None:
+    """Without them BPMN's mapping reads the same drawing as another net: flows become places."""
+    pattern = read_pattern(configured())
+    back = bpmn_to_pattern(unmarked(pattern_to_bpmn(pattern)))
+    assert write_pattern(back) != write_pattern(pattern)
+    assert len(back.processes[0].places) > len(pattern.processes[0].places)
+
+
 def _keys(extra: Any) -> dict[str, Any]:
     return {key: value for key, value in extra.items() if key != "layout"}
 
@@ -161,9 +198,11 @@ def assert_configuration_comes_back(pattern: Pattern, back: Pattern) -> None:
 
 
 @pytest.mark.parametrize("data", _library())
-def test_every_export_imports_back_with_its_configuration(data: dict[str, Any]) -> None:
+def test_every_export_without_marks_imports_back_with_its_configuration(
+    data: dict[str, Any],
+) -> None:
     pattern = read_pattern(data)
-    back = bpmn_to_pattern(pattern_to_bpmn(pattern))
+    back = bpmn_to_pattern(unmarked(pattern_to_bpmn(pattern)))
     assert (back.name, back.declared_pattern) == (pattern.name, pattern.declared_pattern)
     assert _keys(back.extra) == _keys(pattern.extra)
     assert back.constraints == pattern.constraints
@@ -174,9 +213,10 @@ def test_every_export_imports_back_with_its_configuration(data: dict[str, Any]) 
 
 
 @pytest.mark.parametrize("path", LIBRARY, ids=_name)
-def test_every_example_imports_back_with_its_verdict(path: Path) -> None:
+def test_every_example_without_marks_imports_back_with_its_verdict(path: Path) -> None:
     pattern = read_pattern(json.loads(path.read_text()))
-    before, after = check_pattern(pattern), check_pattern(bpmn_to_pattern(pattern_to_bpmn(pattern)))
+    mapped = bpmn_to_pattern(unmarked(pattern_to_bpmn(pattern)))
+    before, after = check_pattern(pattern), check_pattern(mapped)
     assert (after.valid, after.sound, after.patterns) == (
         before.valid,
         before.sound,
@@ -186,7 +226,7 @@ def test_every_example_imports_back_with_its_verdict(path: Path) -> None:
 
 
 def test_the_configured_model_keeps_its_timers_messages_and_cancellation() -> None:
-    back = bpmn_to_pattern(pattern_to_bpmn(read_pattern(configured())))
+    back = bpmn_to_pattern(unmarked(pattern_to_bpmn(read_pattern(configured()))))
     watchdog, loaded = back.transition("x_watchdog"), back.transition("x_loaded")
     assert watchdog is not None
     assert loaded is not None
@@ -325,4 +365,158 @@ def test_generated_exports_with_events_validate_and_import_back(data: dict[str, 
     pattern = read_pattern(data)
     text = pattern_to_bpmn(pattern)
     assert schema_errors(text) == []
-    assert_configuration_comes_back(pattern, bpmn_to_pattern(text))
+    assert_unchanged(pattern, text)
+    assert_configuration_comes_back(pattern, bpmn_to_pattern(unmarked(text)))
+
+
+# Exactly back, and edits made in other tools ---------------------------------------------
+
+NAMES = st.text(max_size=4) | st.sampled_from([" spaced ", "line\nbreak", "o1"])
+
+
+@st.composite
+def awkward(draw: st.DrawFn) -> dict[str, Any]:
+    """What the exporter accepts at its edges: several processes, ids XML cannot hold as ids,
+    names with spaces or none at all, idle, unassigned and undeclared actors, constraints on
+    silent steps in any order, and a layout on some nodes only."""
+    nets = [draw(patterns()) for _ in range(draw(st.integers(1, 3)))]
+    data: dict[str, Any] = {**nets[0], "name": draw(NAMES), "processes": [], "constraints": []}
+    for number, net in enumerate(nets):
+        prefix = draw(st.sampled_from(["", "n ", "9", "\x01", "é"])) + f"{number}_"
+        body = net["processes"][0]
+        rename = {node["id"]: prefix + node["id"] for node in body["places"]}
+        rename |= {t["id"]: prefix + t["id"] for t in body["transitions"]}
+        body["id"] = f"{prefix}N"
+        body["arcs"] = [[rename[a], rename[b]] for a, b in body["arcs"]]
+        for node in body["places"] + body["transitions"]:
+            node["id"] = rename[node["id"]]
+            if draw(st.booleans()):
+                node["label" if "performer" in node else "name"] = draw(NAMES)
+            if "performer" in node and draw(st.booleans()):
+                node["bpmn"] = draw(st.sampled_from(["task", "userTask", "serviceTask", "?"]))
+        body["actors"] = draw(st.sampled_from([body["actors"], [*body["actors"], "idle", "ghost"]]))
+        del body["workpiece"]
+        body.update(draw(st.fixed_dictionaries({}, optional={"name": NAMES, "workpiece": NAMES})))
+        data["processes"].append(body)
+        data["constraints"] += [
+            {**c, "from": rename[c["from"]], "to": rename[c["to"]]} for c in net["constraints"]
+        ]
+        silent = [t["id"] for t in body["transitions"] if "performer" not in t]
+        if silent and data["constraints"]:
+            data["constraints"].append(
+                {"from": silent[0], "to": data["constraints"][0]["from"], "type": "func"}
+            )
+    data["constraints"] = draw(st.permutations(data["constraints"]))
+    actors = {a["id"]: a for net in nets for a in net["actors"]}
+    actors |= {
+        "idle": {"id": "idle", "type": "cobot"},
+        "lonely": {"id": "lonely", "type": "operator"},
+    }
+    for actor in actors.values():
+        if draw(st.booleans()):
+            actor["name"] = draw(st.sampled_from([actor["id"], ""]) | NAMES)
+    data["actors"] = draw(st.permutations(list(actors.values())))
+    if draw(st.booleans()):
+        data = write_pattern(lay_out_pattern(read_pattern(data)))
+        for node in data["processes"][0]["places"]:
+            if draw(st.booleans()):
+                del node["layout"]
+    return data
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(patterns() | decorated() | with_events() | cancelling())
+def test_generated_patterns_import_back_unchanged(data: dict[str, Any]) -> None:
+    pattern = read_pattern(data)
+    assert_unchanged(pattern)
+    assert_unchanged(lay_out_pattern(pattern))
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(awkward())
+def test_patterns_at_the_exporters_edges_import_back_unchanged(data: dict[str, Any]) -> None:
+    assert_unchanged(read_pattern(data))
+
+
+def _xpath(root: Any, path: str) -> list[Any]:
+    found: list[Any] = root.xpath(path, namespaces={"bpmn": BPMN_NAMESPACE, "hrc": HRC_NAMESPACE})
+    return found
+
+
+def _with_a_task_added(text: str) -> str:
+    """The export with a task `check` put into the flow `pa` (load -> inspect), in inspect's
+    lane, as a person would draw it in bpmn-js: a new task and flow, without marks."""
+    root = etree.fromstring(text.encode())
+    flow = _one(root, "//bpmn:sequenceFlow[@id='pa']")
+    target = flow.get("targetRef")
+    flow.set("targetRef", "check")
+    tag = f"{{{BPMN_NAMESPACE}}}"
+    task = etree.Element(f"{tag}task", id="check", name="Check the part")
+    flow.addprevious(task)
+    flow.addnext(
+        etree.Element(f"{tag}sequenceFlow", id="flow_new", sourceRef="check", targetRef=target)
+    )
+    lane = _one(root, f"//bpmn:lane[bpmn:flowNodeRef='{target}']")
+    etree.SubElement(lane, f"{tag}flowNodeRef").text = "check"
+    return str(etree.tostring(root, encoding="unicode"))
+
+
+def test_a_task_added_in_another_tool_is_imported_through_the_mapping() -> None:
+    pattern = read_pattern(configured())
+    back = bpmn_to_pattern(_with_a_task_added(pattern_to_bpmn(pattern)))
+    check = back.transition("check")
+    assert check is not None
+    assert (check.performer, check.label) == ("o1", "Check the part")
+    operator = back.processes[0]
+    assert {("pa", "check"), ("check", "flow_new")} <= set(operator.arcs)
+    assert ("pa", "inspect") not in operator.arcs
+    assert_configuration_comes_back(pattern, back)
+    # The cobot's pool was not touched: it comes back exactly.
+    assert write_pattern(back)["processes"][1] == write_pattern(pattern)["processes"][1]
+
+
+def test_a_task_renamed_and_retyped_in_another_tool_comes_back_so_and_the_rest_unchanged() -> None:
+    data = configured()
+    root = etree.fromstring(pattern_to_bpmn(read_pattern(data)).encode())
+    grasp = _one(root, "//bpmn:task[@id='grasp']")
+    grasp.tag = f"{{{BPMN_NAMESPACE}}}userTask"
+    grasp.set("name", "grasp the part")
+    back = bpmn_to_pattern(etree.tostring(root, encoding="unicode"))
+    task = next(t for t in data["processes"][1]["transitions"] if t["id"] == "grasp")
+    task.update(label="grasp the part", bpmn="userTask")
+    assert write_pattern(back) == write_pattern(read_pattern(data))
+
+
+def test_an_element_whose_id_changed_is_no_longer_taken_for_what_it_stood_for() -> None:
+    """A tool that copies an element keeps its attributes: the copy's mark names the original."""
+    root = etree.fromstring(pattern_to_bpmn(read_pattern(configured())).encode())
+    for reference in _xpath(root, "//*[@sourceRef='grasp' or @targetRef='grasp']"):
+        for key in ("sourceRef", "targetRef"):
+            if reference.get(key) == "grasp":
+                reference.set(key, "grasp_copy")
+    _one(root, "//bpmn:task[@id='grasp']").set("id", "grasp_copy")
+    for reference in _xpath(root, "//*[text()='grasp']"):
+        reference.text = "grasp_copy"
+    back = bpmn_to_pattern(etree.tostring(root, encoding="unicode"))
+    assert back.transition("grasp_copy") is not None
+    cobot = back.processes[1]
+    # Read through the mapping: every flow of the cobot's pool is a place of its own.
+    assert len(cobot.places) > len(read_pattern(configured()).processes[1].places)
+
+
+def test_a_pattern_without_layout_comes_back_without_one() -> None:
+    data = configured()
+    assert "layout" not in data
+    back = write_pattern(assert_unchanged(read_pattern(data)))
+    assert "layout" not in back
+    assert all("layout" not in p for net in back["processes"] for p in net["places"])
+
+
+def test_every_mark_names_an_element_of_its_process() -> None:
+    root = etree.fromstring(pattern_to_bpmn(read_pattern(configured())).encode())
+    for net in _xpath(root, "//bpmn:process"):
+        ids = set(net.xpath(".//@id"))
+        for element in net.xpath(".//*[@hrc:net]", namespaces={"hrc": HRC_NAMESPACE}):
+            words = element.get(f"{{{HRC_NAMESPACE}}}net").split()
+            assert words[0] in {"transition", "join", "place", "split", "merge", "arc"}
+            assert words[1:] == [] if words[0] == "arc" else words[1] in ids
