@@ -260,7 +260,7 @@ def test_without_cancels_the_same_terminate_leaves_work_over() -> None:
     assert improper.witness is not None
     assert improper.witness[-1] == "xend"
     # The reduction runs tb's branch on to its join as a whole: p6 is where it waits.
-    assert "place p6 still holds one" in improper.message
+    assert "place p6 still holds 1 token" in improper.message
 
 
 def test_a_witness_through_a_cancel_replays_and_names_what_it_missed() -> None:
@@ -274,7 +274,7 @@ def test_a_witness_through_a_cancel_replays_and_names_what_it_missed() -> None:
     assert improper.message == (
         "The case can end with work left over: after split/join xf fires, task ta starts, "
         "task ta completes, timer xt rings and cancels task ta and place pt, split/join xto "
-        "fires, the end place has its token while place pd still holds one."
+        "fires, the end place has its token while place pd still holds 1 token."
     )
     by_label = {t.label: t for t in net.transitions}
     marking = net.initial
