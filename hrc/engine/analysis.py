@@ -7,6 +7,11 @@ expanded back into the original firings, is the witness shown to the
 engineer (shortest up to the steps the reduction takes at once: a chain of
 firings that nothing can interrupt is shown whole).
 
+A process that completes implicitly (`Net.implicit`) has finished with any
+number of tokens in its sink place and no other; its sink's tokens are
+counted up to one (`_Explorer._counted`), and its tokens elsewhere while the
+ends are marked mean it still runs, not that it ended improperly.
+
 Reset arcs (`cancels`) are honoured, and they weaken one argument: a marking
 that covers an ancestor proves a place unbounded only if no firing on the way
 between them empties that place, since repeating the way would empty it again.
@@ -101,6 +106,8 @@ class _Explorer:
             if pre:
                 self.consumers[pre[0]].append(t)
         self.ignored = {self.index[p] for p in net.ignored if p in self.index}
+        self.implicit = {self.index[p] for p in net.implicit if p in self.index}
+        self.open_ends = {self.index[p] for p in net.open_ends}
         self.final = self._state(net.final)
         self.final_counts = Counter(self.final)
         self.cyclic = _has_cycle(reduced)
@@ -116,7 +123,20 @@ class _Explorer:
         return tuple(sorted(self.index[place] for place, weight in arcs for _ in range(weight)))
 
     def _state(self, marking: Marking) -> _State:
-        return tuple(sorted(self.index[p] for p, n in marking.items() for _ in range(n)))
+        tokens = sorted(self.index[p] for p, n in marking.items() for _ in range(n))
+        return self._counted(tokens)
+
+    def _counted(self, tokens: list[int]) -> _State:
+        """The sorted tokens as a state, an open end's counted up to one: nothing takes a token
+        from a sink, so more of them enable nothing more, and a loop that ends a branch on each
+        round stays bounded, as in BPMN, where the end event consumes the token."""
+        if not self.open_ends:
+            return tuple(tokens)
+        kept: list[int] = []
+        for i in tokens:
+            if not (kept and kept[-1] == i and i in self.open_ends):
+                kept.append(i)
+        return tuple(kept)
 
     def marking(self, state: _State) -> Marking:
         return Marking((self.reduced.places[i], n) for i, n in Counter(state).items())
@@ -135,7 +155,7 @@ class _Explorer:
                     tokens = [i for i in tokens if i not in self.resets[t]]
                 tokens.extend(self.post[t])
                 tokens.sort()
-                yield t, tuple(tokens)
+                yield t, self._counted(tokens)
 
     def _add(self, state: _State, parent: tuple[int, int] | None) -> int:
         number = self.ids[state] = len(self.order)
@@ -188,7 +208,8 @@ class _Explorer:
 
     def _covering(self, number: int) -> Fault | None:
         """An ancestor this marking strictly covers proves a place unbounded (Karp–Miller),
-        when a place that grew is emptied by no reset on the way from the ancestor."""
+        when a place that grew is emptied by no reset on the way from the ancestor, and is no
+        open end, whose tokens are counted up to one."""
         state = self.order[number]
         counts = Counter(state)
         emptied: set[int] = set()
@@ -199,7 +220,11 @@ class _Explorer:
             # Fewer tokens first: it is cheap and rules out most ancestors of a bounded net.
             fewer = len(self.order[ancestor]) < len(state)
             if fewer and (smaller := Counter(self.order[ancestor])) <= counts:
-                grown = [i for i in counts if counts[i] > smaller[i] and i not in emptied]
+                grown = [
+                    i
+                    for i in counts
+                    if counts[i] > smaller[i] and i not in emptied and i not in self.open_ends
+                ]
                 if grown:
                     prefix = self.path(ancestor)
                     return Fault(
@@ -226,8 +251,13 @@ class _Explorer:
         return tuple(i for i in state if i not in self.ignored) == self.final
 
     def is_improper(self, state: _State) -> bool:
-        """The end is marked but something else (apart from constraint places) still is too."""
-        return self.final_counts <= Counter(state) and not self.is_final(state)
+        """The end is marked but something else (apart from constraint places) still is too,
+        a token of a process that completes implicitly aside: that process still runs."""
+        counts = Counter(state)
+        if not self.final_counts <= counts:
+            return False
+        left = counts - self.final_counts
+        return any(i not in self.ignored and i not in self.implicit for i in left)
 
     def fault(self, kind: FaultKind, number: int) -> Fault:
         return Fault(kind, self.marking(self.order[number]), self.path(number))
