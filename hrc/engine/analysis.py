@@ -7,6 +7,11 @@ expanded back into the original firings, is the witness shown to the
 engineer (shortest up to the steps the reduction takes at once: a chain of
 firings that nothing can interrupt is shown whole).
 
+A process that completes implicitly (`Net.implicit`) has finished with any
+number of tokens in its sink place and no other; its sink's tokens are
+counted up to one (`_Explorer._counted`), and its tokens elsewhere while the
+ends are marked mean it still runs, not that it ended improperly.
+
 Reset arcs (`cancels`) are honoured, and they weaken one argument: a marking
 that covers an ancestor proves a place unbounded only if no firing on the way
 between them empties that place, since repeating the way would empty it again.
@@ -17,13 +22,14 @@ was found by then is reported, and a verdict that needs the whole space
 becomes "too large to decide" instead of a hang.
 """
 
+import gc
 from collections import Counter, deque
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Literal
 
 from hrc.engine.budget import NO_TIME_LIMIT, Budget, Deadline
-from hrc.engine.graph import reachable
 from hrc.engine.petri import Marking, Net
 from hrc.engine.reduction import ReducedNet, reduce_net
 
@@ -101,7 +107,11 @@ class _Explorer:
             if pre:
                 self.consumers[pre[0]].append(t)
         self.ignored = {self.index[p] for p in net.ignored if p in self.index}
+        self.implicit = {self.index[p] for p in net.implicit if p in self.index}
+        self.open_ends = {self.index[p] for p in net.open_ends}
         self.final = self._state(net.final)
+        # Only a firing that marks an open end can put a second token there.
+        self.ends = [not self.open_ends.isdisjoint(post) for post in self.post]
         self.final_counts = Counter(self.final)
         self.cyclic = _has_cycle(reduced)
         self.ids: dict[_State, int] = {}
@@ -116,7 +126,20 @@ class _Explorer:
         return tuple(sorted(self.index[place] for place, weight in arcs for _ in range(weight)))
 
     def _state(self, marking: Marking) -> _State:
-        return tuple(sorted(self.index[p] for p, n in marking.items() for _ in range(n)))
+        tokens = sorted(self.index[p] for p, n in marking.items() for _ in range(n))
+        return self._counted(tokens)
+
+    def _counted(self, tokens: list[int]) -> _State:
+        """The sorted tokens as a state, an open end's counted up to one: nothing takes a token
+        from a sink, so more of them enable nothing more, and a loop that ends a branch on each
+        round stays bounded, as in BPMN, where the end event consumes the token."""
+        if not self.open_ends:
+            return tuple(tokens)
+        kept: list[int] = []
+        for i in tokens:
+            if not (kept and kept[-1] == i and i in self.open_ends):
+                kept.append(i)
+        return tuple(kept)
 
     def marking(self, state: _State) -> Marking:
         return Marking((self.reduced.places[i], n) for i, n in Counter(state).items())
@@ -135,7 +158,7 @@ class _Explorer:
                     tokens = [i for i in tokens if i not in self.resets[t]]
                 tokens.extend(self.post[t])
                 tokens.sort()
-                yield t, tuple(tokens)
+                yield t, self._counted(tokens) if self.ends[t] else tuple(tokens)
 
     def _add(self, state: _State, parent: tuple[int, int] | None) -> int:
         number = self.ids[state] = len(self.order)
@@ -188,7 +211,8 @@ class _Explorer:
 
     def _covering(self, number: int) -> Fault | None:
         """An ancestor this marking strictly covers proves a place unbounded (Karp–Miller),
-        when a place that grew is emptied by no reset on the way from the ancestor."""
+        when a place that grew is emptied by no reset on the way from the ancestor, and is no
+        open end, whose tokens are counted up to one."""
         state = self.order[number]
         counts = Counter(state)
         emptied: set[int] = set()
@@ -199,7 +223,11 @@ class _Explorer:
             # Fewer tokens first: it is cheap and rules out most ancestors of a bounded net.
             fewer = len(self.order[ancestor]) < len(state)
             if fewer and (smaller := Counter(self.order[ancestor])) <= counts:
-                grown = [i for i in counts if counts[i] > smaller[i] and i not in emptied]
+                grown = [
+                    i
+                    for i in counts
+                    if counts[i] > smaller[i] and i not in emptied and i not in self.open_ends
+                ]
                 if grown:
                     prefix = self.path(ancestor)
                     return Fault(
@@ -226,8 +254,13 @@ class _Explorer:
         return tuple(i for i in state if i not in self.ignored) == self.final
 
     def is_improper(self, state: _State) -> bool:
-        """The end is marked but something else (apart from constraint places) still is too."""
-        return self.final_counts <= Counter(state) and not self.is_final(state)
+        """The end is marked but something else (apart from constraint places) still is too,
+        a token of a process that completes implicitly aside: that process still runs."""
+        counts = Counter(state)
+        if not self.final_counts <= counts:
+            return False
+        left = counts - self.final_counts
+        return any(i not in self.ignored and i not in self.implicit for i in left)
 
     def fault(self, kind: FaultKind, number: int) -> Fault:
         return Fault(kind, self.marking(self.order[number]), self.path(number))
@@ -239,9 +272,13 @@ def analyse(net: Net, budget: Budget = NO_TIME_LIMIT, deadline: Deadline | None 
     `deadline` is the one of a larger check that already started; by default
     the budget's time starts now.
     """
-    deadline = deadline or budget.start()
+    with _no_cycle_collection():
+        return _explored(net, budget.max_markings, deadline or budget.start())
+
+
+def _explored(net: Net, max_markings: int, deadline: Deadline) -> Analysis:
     reduced = reduce_net(net)
-    explorer = _Explorer(net, reduced, budget.max_markings, deadline)
+    explorer = _Explorer(net, reduced, max_markings, deadline)
     explorer.explore()
     faults: list[Fault] = []
     if explorer.unbounded is not None:
@@ -259,6 +296,22 @@ def analyse(net: Net, budget: Budget = NO_TIME_LIMIT, deadline: Deadline | None 
     }
     decided = explorer.stopped_by is None
     return Analysis(decided, tuple(faults), stats, explorer.stopped_by)
+
+
+@contextmanager
+def _no_cycle_collection() -> Iterator[None]:
+    """Python's cycle collector paused while the space is walked and freed. Its markings and
+    edges are millions of objects without cycles (refcounting frees them), yet each full
+    collection walks them all: a third of the time of a large space, in pauses of a tenth of a
+    second that no clock read can cut short, so a check ran on well past its deadline. They are
+    freed before the collector resumes, or its first collection would walk them all again."""
+    paused = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if paused:
+            gc.enable()
 
 
 def _local_faults(explorer: _Explorer) -> Iterator[Fault]:
@@ -287,33 +340,52 @@ def _global_faults(explorer: _Explorer) -> Iterator[Fault]:
 
     Nothing when the deadline passes first (`explorer.stopped_by` says so): a
     livelock or a dead transition found in part of the space is no finding.
+    Each walk over the space reads the clock as the exploration's phases do.
     """
-    reverse: dict[int, list[int]] = {number: [] for number in range(len(explorer.order))}
+    reverse: list[list[int]] = [[] for _ in explorer.order]
+    finals: list[int] = []
+    dead_ends: list[int] = []
+    fired: set[int] = set()
     for number, out in enumerate(explorer.edges):
         if explorer.out_of_time(number):
             return
-        for _, successor in out:
+        for t, successor in out:
             reverse[successor].append(number)
-    numbers = range(len(explorer.order))
-    can_finish = reachable([n for n in numbers if explorer.is_final(explorer.order[n])], reverse)
-    if explorer.out_of_time(0):
-        return
-    can_end = reachable([n for n in numbers if not explorer.edges[n]], reverse)
-    if explorer.out_of_time(0):
+            fired.add(t)
+        if explorer.is_final(explorer.order[number]):
+            finals.append(number)
+        if not out:
+            dead_ends.append(number)
+    can_finish = _backwards(explorer, finals, reverse)
+    can_end = _backwards(explorer, dead_ends, reverse) if can_finish is not None else None
+    if can_finish is None or can_end is None:
         return
     # A livelock: the case runs on but can neither finish nor even get stuck.
-    looping = next((n for n in numbers if n not in can_finish and n not in can_end), None)
+    looping = next(
+        (n for n in range(len(explorer.order)) if n not in can_finish and n not in can_end), None
+    )
     if looping is not None:
         yield explorer.fault("livelock", looping)
-    fired = {
-        firing
-        for out in explorer.edges
-        for t, _ in out
-        for firing in explorer.reduced.transitions[t].firings
-    }
+    firings = {firing for t in fired for firing in explorer.reduced.transitions[t].firings}
     for transition in explorer.net.transitions:
-        if transition.id not in fired:
+        if transition.id not in firings:
             yield Fault("dead", None, transition=transition.id)
+
+
+def _backwards(explorer: _Explorer, starts: list[int], reverse: list[list[int]]) -> set[int] | None:
+    """The markings from which one of `starts` is reachable; None when the deadline passed."""
+    reached = set(starts)
+    queue = deque(starts)
+    step = 0
+    while queue:
+        step += 1
+        if explorer.out_of_time(step):
+            return None
+        for predecessor in reverse[queue.popleft()]:
+            if predecessor not in reached:
+                reached.add(predecessor)
+                queue.append(predecessor)
+    return reached
 
 
 def _has_cycle(net: ReducedNet) -> bool:

@@ -12,7 +12,7 @@ of business process models in BPMN", Information and Software Technology 50
 | task T (task, userTask, manualTask, serviceTask, scriptTask, businessRuleTask, sendTask, receiveTask) | transition T performed by its lane's actor, labelled with its name (a kind other than `task` kept in its `bpmn` key); arcs from its incoming and to its outgoing flows' places. Several incoming flows merge first (the paper's normalisation: an exclusive merge, a silent transition per flow into a place `T_in`); several outgoing flows all get a token (a parallel split) |
 | none intermediate event E | silent transition E, with the same arcs as a task |
 | start event S | a silent transition from the net's source place into its outgoing flows. The source place is S itself when the process has one start event (the step gets a fresh id), else `<process>_start` with each start event a transition S out of it (an instance starts at one of them). A process without start events starts at every node no flow enters (BPMN's implicit start) |
-| end event E | a silent transition per incoming flow into the net's sink place: E itself when there is one end event, else `<process>_end`. A node no flow leaves ends its path through an extra end (BPMN's implicit end) |
+| end event E | a silent transition per incoming flow into the net's sink place: E itself when there is one end event, else `<process>_end`. A node no flow leaves ends its path through an extra end (BPMN's implicit end). As each end event consumes its token, the process gets `"completion": "implicit"`: a case has completed when all its tokens lie in the sink place, however many (not so in a file hrc exported, whose processes keep the pattern's rule) |
 | parallel gateway G (fork, join, or both) | one silent transition G consuming all incoming and producing all outgoing flows |
 | exclusive gateway G | a place where the choice or merge happens, with a silent transition per branch: a split keeps its incoming flow's place and gets a transition `G_<flow>` into each outgoing flow's place (the flow's condition becomes that transition's `guard`; the default flow's is "none of the others"); a merge gets a transition per incoming flow into the outgoing flow's place; a gateway with several of each gets its own place G between them |
 | condition on a flow | a `guard` in hrc's language (`${a > 3}`, `#{ok && !late}`, `a gt 3` become `data.a > 3`, `data.ok and not data.late`, ... see `bpmn_conditions`); one that does not translate (prose, XPath, method calls) leaves the branch without guard and with a `rewrite` key saying what to rewrite, so the model stays a draft. An empty `<conditionExpression/>` is no condition. The variables a translated condition reads become the document's `data` with a default of the type they are compared with (0, "", else false), so a case can start and its start form asks for them. Conditions (or a default flow) on the flows out of a task or event: a silent exclusive choice after it |
@@ -484,6 +484,9 @@ class _Importer:
         data["actors"] = list(dict.fromkeys(performers.values()))
         if element.get("name"):
             data["name"] = element.get("name")
+        if self.root.get("exporter") != "hrc":
+            # BPMN's own rule; a file hrc wrote keeps the pattern's, in its hrc:extra if any.
+            data["completion"] = "implicit"
         data.update(
             {
                 k: v

@@ -153,9 +153,11 @@ class _Explainer:
     def left_over(self, marking: Marking) -> tuple[str, list[str]]:
         """What an improper end leaves, each place with its count: tokens beside the end
         place's, and tokens on an end place beyond the one a finished case leaves there."""
-        final = self.net.final
-        surplus = sorted(p for p in final if marking.get(p) > final[p])
-        left = sorted(p for p in marking if p not in final and p not in self.net.ignored)
+        final, running = self.net.final, self.net.implicit  # a process ending implicitly runs on
+        surplus = sorted(p for p in final if marking.get(p) > final[p] and p not in running)
+        left = sorted(
+            p for p in marking if p not in final and p not in self.net.ignored and p not in running
+        )
         holds = [self.still_holds(p, marking[p]) for p in left]
         elements = [*surplus, *(self.task_of(p) for p in left)]
         if not surplus:

@@ -13,6 +13,10 @@ extra places (pattern-format.md, "Execution semantics"):
 - space (a, b): no place; the order is free and the runtime interrupts the
   cobot while both run.
 
+A process with `"completion": "implicit"` has its places (its tasks' `running:`
+places too) in the net's `implicit`: it has completed once its tokens all lie
+in its sink place, however many (BPMN: each end event consumes its token).
+
 A silent transition with `cancels` resets what it names when it fires: a
 place is emptied, a task's `running:t` too (the task is cancelled), and with
 it the func constraint places that stand for that run of t: `func-start:t>d`
@@ -103,8 +107,12 @@ def build_execution_net(pattern: Pattern) -> Net:
     resets: dict[str, tuple[str, ...]] = {}
     initial: dict[str, int] = {}
     final: dict[str, int] = {}
+    implicit: list[str] = []
     for process in pattern.processes:
         places.extend(p.id for p in process.places)
+        if process.completes_implicitly:
+            implicit.extend(p.id for p in process.places)
+            implicit.extend(f"running:{t.id}" for t in process.transitions if t.is_task)
         initial.update(process.initial_marking())
         for sink in process.sink_places():
             final[sink] = final.get(sink, 0) + 1
@@ -157,6 +165,7 @@ def build_execution_net(pattern: Pattern) -> Net:
         initial=Marking(initial),
         final=Marking(final),
         ignored=frozenset(ignored),
+        implicit=frozenset(implicit),
     )
 
 

@@ -13,10 +13,12 @@ from typing import Any, Literal, TypeVar
 
 ActorType = Literal["cobot", "operator"]
 ConstraintType = Literal["time", "space", "func"]
+Completion = Literal["proper", "implicit"]
 PatternName = Literal["synchronized", "cooperation", "collaboration", "coexistence"]
 
 ACTOR_TYPES: tuple[ActorType, ...] = ("cobot", "operator")
 CONSTRAINT_TYPES: tuple[ConstraintType, ...] = ("time", "space", "func")
+COMPLETIONS: tuple[Completion, ...] = ("proper", "implicit")
 PATTERN_NAMES: tuple[PatternName, ...] = (
     "synchronized",
     "cooperation",
@@ -66,6 +68,13 @@ class Process:
     transitions: tuple[Transition, ...]
     arcs: tuple[tuple[str, str], ...]
     extra: Extra = field(default_factory=dict, compare=False)
+
+    @property
+    def completes_implicitly(self) -> bool:
+        """Whether a case of this process has completed once all its tokens lie in its sink place,
+        however many (`"completion": "implicit"`, BPMN's rule: each end event consumes its token),
+        rather than when exactly one does. A value other than COMPLETIONS is a rule's to report."""
+        return self.extra.get("completion") == "implicit"
 
     def source_places(self) -> list[str]:
         """Places with no incoming arc, in document order."""

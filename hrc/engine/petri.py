@@ -106,6 +106,12 @@ class Net:
     `ignored` are the places proper completion does not look at (the
     constraint places: a time constraint whose t_b never ran may leave a
     token there, and that is no fault of the model).
+
+    `implicit` are the places (`running:` ones included) of the processes
+    that complete implicitly: such a process has completed when its sink
+    place holds any number of tokens (one at least) and none of its other
+    places hold any, and a token elsewhere in it means it still runs, not that
+    it ended with work left over.
     """
 
     places: tuple[str, ...]
@@ -113,11 +119,24 @@ class Net:
     initial: Marking
     final: Marking
     ignored: frozenset[str] = field(default_factory=frozenset)
+    implicit: frozenset[str] = field(default_factory=frozenset)
+
+    @property
+    def open_ends(self) -> frozenset[str]:
+        """The sink places of the processes that complete implicitly: any count ≥ 1 is final."""
+        return self.implicit & frozenset(self.final)
 
     def enabled(self, marking: Mapping[str, int]) -> list[NetTransition]:
         """The transitions that can fire in this marking, in net order."""
         return [t for t in self.transitions if t.is_enabled(marking)]
 
     def is_final(self, marking: Marking) -> bool:
-        """Proper completion: the final marking, constraint places aside."""
-        return marking.restricted(self.ignored) == self.final
+        """Proper completion: the final marking, constraint places aside, where an open end
+        (`open_ends`) may hold more than its one token."""
+        left = marking.restricted(self.ignored)
+        if set(left) != set(self.final):
+            return False
+        return all(
+            left[place] == tokens or (left[place] > tokens and place in self.implicit)
+            for place, tokens in self.final.items()
+        )

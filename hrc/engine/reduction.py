@@ -19,6 +19,10 @@ can fire. Every reduced transition remembers the original firings it stands
 for, so a witness found in the reduced net expands into a firing sequence of
 the original.
 
+A process that completes implicitly changes nothing here: its sink place is
+part of the final marking, so it stays, and a token moved on early by t lies
+in the same process, which has not completed while a token is in p either.
+
 Reset arcs (`cancels`) are kept: a producer h keeps its resets, which happen
 before t's tokens arrive as they would have. A reset region must take p and
 t's outputs together or leave them all alone: then emptying the region

@@ -11,7 +11,7 @@ from collections.abc import Iterable
 
 from hrc.engine.graph import reachable
 from hrc.engine.issues import STRUCTURAL_CODES, Issue, error
-from hrc.engine.model import CONSTRAINT_TYPES, Pattern, Process
+from hrc.engine.model import COMPLETIONS, CONSTRAINT_TYPES, Pattern, Process
 from hrc.engine.wording import Names, sentence
 
 __all__ = ["STRUCTURAL_CODES", "check_rules"]
@@ -30,6 +30,7 @@ def check_rules(pattern: Pattern) -> list[Issue]:
         *_no_actors(pattern, names),
         *_workpieces(pattern, names),
         *(issue for process in pattern.processes for issue in _workflow_net(process, names)),
+        *_completions(pattern, names),
         *_to_rewrite(pattern, names),
     ]
 
@@ -299,6 +300,20 @@ def _workflow_net(process: Process, names: Names) -> Iterable[Issue]:
             process.id,
             *stray,
         )
+
+
+def _completions(pattern: Pattern, names: Names) -> Iterable[Issue]:
+    """`completion` says when a case of the process has completed; another value leaves it open."""
+    for process in pattern.processes:
+        given = process.extra.get("completion", "proper")
+        if given not in COMPLETIONS:
+            yield error(
+                "format",
+                f"{sentence(names.process(process.id))} has completion {given!r}: it is "
+                '"proper" (one token in its end place, nothing else left; the default) or '
+                '"implicit" (every token in its end place, however many: BPMN\'s rule).',
+                process.id,
+            )
 
 
 def _to_rewrite(pattern: Pattern, names: Names) -> Iterable[Issue]:

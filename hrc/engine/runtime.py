@@ -207,6 +207,8 @@ class CaseNet:
         return self.net.initial
 
     def is_final(self, marking: Marking) -> bool:
+        """Whether the case has completed: each end place marked and nothing else, constraint
+        places aside; the end of a process that completes implicitly may hold several tokens."""
         return self.net.is_final(marking)
 
     # Silent transitions ------------------------------------------------------------

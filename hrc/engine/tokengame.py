@@ -22,7 +22,8 @@ on the pattern's own elements:
       "arcs": [["p2", "start:tc1"], ["start:tc1", "running:tc1"], ...],
       "initial": {"p1": 1},
       "final": {"p9": 1},
-      "ignored": ["time:to1>tc2"]
+      "ignored": ["time:to1>tc2"],
+      "open_ends": []
     }
 
 - a `flow` place is a place of the pattern (`of`: its id); a `busy` place is
@@ -39,7 +40,8 @@ on the pattern's own elements:
   cancels task t), and putting one in each output place; silent steps fire
   at once, the game leaving a timer's wait out;
 - the case ends properly in `final`, whatever the `ignored` (constraint)
-  places hold.
+  places hold; an `open_ends` place (the end of a process with
+  `"completion": "implicit"`) may then hold more than its one token.
 """
 
 from typing import Any
@@ -95,6 +97,7 @@ def execution_net_json(pattern: Pattern) -> Json:
         "initial": dict(net.initial),
         "final": dict(net.final),
         "ignored": sorted(net.ignored),
+        "open_ends": sorted(net.open_ends),
     }
 
 

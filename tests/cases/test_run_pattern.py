@@ -12,10 +12,12 @@ from typing import Any
 import pytest
 from django.core.management import CommandError, call_command
 
+from hrc.engine.bpmn import bpmn_to_document
 from hrc.engine.document import read_pattern
 from hrc.engine.execution import supporter_of
 from hrc.engine.model import Pattern
 from hrc.engine.runtime import CaseNet
+from tests.engine.test_completion import PARALLEL_ENDS
 
 EXAMPLES = sorted((Path(__file__).parents[2] / "hrc" / "patterns" / "examples").glob("*.json"))
 EVENTS = {
@@ -157,3 +159,24 @@ def test_a_file_that_does_not_check_names_its_errors(tmp_path: Path) -> None:
         run_pattern(broken)
     with pytest.raises(CommandError, match="Cannot read"):
         run_pattern(tmp_path / "missing.json")
+
+
+@pytest.mark.django_db(transaction=True)
+def test_an_imported_bpmn_process_whose_branches_end_apart_completes(tmp_path: Path) -> None:
+    # BPMN's implicit completion: each branch of the parallel split ends at its own end event.
+    path = tmp_path / "parallel-ends.json"
+    path.write_text(json.dumps(bpmn_to_document(PARALLEL_ENDS)))
+
+    events = run_pattern(path, "--cases", "2", "--time-scale", "0", "--seed", "5")
+
+    cases = {e["case"] for e in events}
+    assert len(cases) == 2
+    for case in cases:
+        trace = [e["event"] + " " + (e["task"] or "") for e in events if e["case"] == case]
+        assert sorted(trace[:-1]) == [
+            "task-completed a",
+            "task-completed b",
+            "task-started a",
+            "task-started b",
+        ]
+        assert trace[-1].startswith("case-completed")

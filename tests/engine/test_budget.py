@@ -1,11 +1,13 @@
 """The check's budget: a deadline that every phase walking the state space honours.
 
 The clocks here are counters, so the tests say when time runs out without
-waiting for it and without depending on the machine's speed.
+waiting for it and without depending on the machine's speed; one test, with
+room to spare, holds a generated large net to a real deadline.
 """
 
 import itertools
 import math
+import time
 from collections.abc import Callable
 
 from hrc.engine import check_document, read_pattern
@@ -74,3 +76,53 @@ def test_a_fault_found_before_the_deadline_is_reported_but_no_whole_space_verdic
     assert [e.code for e in report.errors] == ["unsound"]
     assert "can get stuck" in report.errors[0].message
     assert "never start" in check_document(data).errors[-1].message  # given the time
+
+
+def _counting() -> tuple[Callable[[], float], Callable[[], int]]:
+    """A clock that never reaches a deadline, and how often it was read."""
+    ticks = itertools.count()
+    reads = [0]
+
+    def clock() -> float:
+        reads[0] = next(ticks) + 1
+        return 0.0
+
+    return clock, lambda: reads[0]
+
+
+def test_every_walk_over_the_state_space_reads_the_clock_as_it_goes() -> None:
+    net = build_execution_net(read_pattern(parallel_lanes(4, 8)))
+    clock, reads = _counting()
+
+    analysis = analyse(net, Budget(seconds=1, clock=clock))
+
+    assert analysis.sound is True
+    markings = analysis.stats["markings"]
+    assert markings > 4 * 1024
+    # The exploration reads it once per marking; the fault scan, the reversed edges and the
+    # two backward searches (to the end, to a dead end) every 1 024 markings each.
+    assert reads() >= 1 + markings + 4 * (markings // 1024)
+
+
+def test_a_deadline_passing_in_the_backward_search_stops_it_undecided() -> None:
+    net = build_execution_net(read_pattern(parallel_lanes(4, 8)))
+    markings = analyse(net).stats["markings"]
+    walks_before = 2 * (markings // 1024 + 1)  # the fault scan and the reversed edges
+    budget = Budget(seconds=1, clock=_stopping_after(1 + markings + walks_before + 1))
+
+    analysis = analyse(net, budget)
+
+    assert (analysis.decided, analysis.stopped_by, analysis.faults) == (False, "time", ())
+
+
+def test_a_large_generated_net_is_too_large_to_decide_within_a_small_real_budget() -> None:
+    data = parallel_lanes(6, 8)  # 200 000 markings and more: seconds to explore them all
+
+    started = time.monotonic()
+    report = check_document(data, Budget(seconds=0.3))
+    took = time.monotonic() - started
+
+    assert report.sound is None
+    assert report.warnings[0].message.startswith("The model is too large to decide in 0.3 s")
+    # Past the deadline only the marking under way is finished and the space freed.
+    assert took < 0.3 + 0.3
