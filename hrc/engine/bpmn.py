@@ -478,6 +478,7 @@ class _Importer:
             net.ends(graph.starts.get(scope_id, []), scope, start=True)
             net.ends(graph.ends.get(scope_id, []), scope, start=False)
         net.finish()
+        _mark_the_start(net)
         for key, value in graph.data.items():
             self.data.setdefault(key, value)
         data: Json = {"id": process_id, "workpiece": _workpiece(element, pool, process_id)}
@@ -708,3 +709,14 @@ class _Importer:
             constraint.update({k: v for k, v in extra.items() if k != "id"})
             self.constraints.append(constraint)
             self.drawn_constraints[xml_id] = constraint
+
+
+def _mark_the_start(net: FlowNet) -> None:
+    """Writes the start's token once a place no token reaches says it holds none: the default
+    marking (a token in every place no arrow enters) would start the case there too."""
+    if not any(place.get("tokens") == 0 for place in net.places):
+        return
+    entered = {target for _, target in net.arcs}
+    for place in net.places:
+        if place["id"] not in entered and "tokens" not in place:
+            place["tokens"] = 1

@@ -229,7 +229,7 @@ class FlowNet:
             self._exclusive(node)
         elif node.kind == "inclusiveGateway":
             self._inclusive(node)
-        elif node.kind not in ("startEvent", "endEvent", "caughtBoundaryEvent"):
+        elif node.kind not in ("startEvent", "endEvent", "caughtBoundaryEvent", "unreached"):
             self._activity(node, performer)
 
     def _step(

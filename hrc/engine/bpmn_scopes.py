@@ -644,14 +644,7 @@ class ProcessReader:
         nodes with no flow in, and a node with no flow out end its path."""
         nodes = list(dict.fromkeys([*entry.values(), *exit_.values()]))
         if not starts:
-            first = [
-                n
-                for n in dict.fromkeys(entry.values())
-                if not n.incoming
-                and n.kind not in ("boundaryEvent", "endEvent")
-                and not n.pre
-                and not (n.kind == "intermediateCatchEvent" and n.keys.get("bpmn") == "link")
-            ]
+            first = self._unreached(entry)
             if first:
                 start = self._node(
                     "startEvent",
@@ -663,6 +656,19 @@ class ProcessReader:
                 for node in first:
                     self.synthetic_flow(start, node, scope)
                 starts.append(start)
+        else:
+            # Beside start events BPMN never starts a node no flow enters (a flow lost in an
+            # export, say): it waits on a place no token ever reaches, so the check finds it dead.
+            for node in self._unreached(entry):
+                source = self._node(
+                    "unreached",
+                    node.xml_id,
+                    self.reading.fresh(f"{node.hrc_id}_unreached"),
+                    None,
+                    scope,
+                )
+                flow = self.synthetic_flow(source, node, scope)
+                flow.extra = {"tokens": 0, "name": f"nothing reaches the {node.describe()}"}
         # A node with no flow out ends its path, end events or not (BPMN's implicit end).
         last = [
             n
@@ -683,6 +689,18 @@ class ProcessReader:
             for node in last:
                 self.synthetic_flow(node, end, scope)
             ends.append(end)
+
+    @staticmethod
+    def _unreached(entry: dict[str, FlowNode]) -> list[FlowNode]:
+        """The nodes no flow enters that BPMN would start only in a scope without start events."""
+        return [
+            n
+            for n in dict.fromkeys(entry.values())
+            if not n.incoming
+            and n.kind not in ("startEvent", "boundaryEvent", "endEvent")
+            and not n.pre
+            and not (n.kind == "intermediateCatchEvent" and n.keys.get("bpmn") == "link")
+        ]
 
     # Events.
 

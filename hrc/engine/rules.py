@@ -249,8 +249,19 @@ def _workpieces(pattern: Pattern, names: Names) -> Iterable[Issue]:
 
 
 def _workflow_net(process: Process, names: Names) -> Iterable[Issue]:
-    """A workflow net has one source place, one sink place, and every node on a path between."""
+    """A workflow net has one source place, one sink place, and every node on a path between.
+
+    A process imported from BPMN (implicit completion) may also hold places nothing enters
+    that are written with no token: BPMN never starts what waits there, so they are no start,
+    and the analysis finds what follows them dead.
+    """
     sources, sinks = process.source_places(), process.sink_places()
+    unreached = [
+        p.id
+        for p in process.places
+        if process.completes_implicitly and p.tokens == 0 and p.id in sources
+    ]
+    sources = [place for place in sources if place not in unreached]
     if len(sources) != 1 or len(sinks) != 1:
         parts = []
         if not sources:
@@ -282,7 +293,7 @@ def _workflow_net(process: Process, names: Names) -> Iterable[Issue]:
     for source, target in process.arcs:
         successors[source].append(target)
         predecessors[target].append(source)
-    forward = reachable([sources[0]], successors)
+    forward = reachable([sources[0], *unreached], successors)
     backward = reachable([sinks[0]], predecessors)
     nodes = [p.id for p in process.places] + [t.id for t in process.transitions]
     counts = Counter(nodes)

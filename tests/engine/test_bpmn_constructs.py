@@ -537,3 +537,19 @@ def test_a_receive_task_with_a_boundary_event_waits_for_its_message_inside_its_s
     assert {("take_start", "take_receive"), ("take_receive", "take_received")} <= _arcs(pattern)
     assert ("take_start", "take") not in _arcs(pattern)
     assert not [e for e in check_pattern(pattern).errors if e.code == "not-workflow-net"]
+
+
+def test_a_node_no_flow_enters_beside_a_start_event_is_never_started_and_found_dead() -> None:
+    # As in Bonita's export of MIWG C.1.0, which lost the flow into a gateway.
+    pattern = bpmn_to_pattern(
+        bpmn(
+            '<startEvent id="s"/><task id="a" name="Approve"/><endEvent id="e"/>'
+            '<exclusiveGateway id="g" name="Review successful"/><task id="b" name="Pay"/>'
+            + flows("f1: s -> a", "f2: a -> e", "f3: g -> b", "f4: b -> e")
+        )
+    )
+    assert _run(pattern, {}) == ["a"]
+    report = check_pattern(pattern)
+    assert [issue.code for issue in report.errors] == ["unsound"]
+    assert "never" in report.errors[0].message
+    assert "Pay" in report.errors[0].message
