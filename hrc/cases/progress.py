@@ -156,8 +156,7 @@ def _settle(case: Case, net: CaseNet) -> bool:
     after, fired = net.settle(before, case.data)
     marking = before
     for transition in fired:
-        before_one, after_one = marking, net.transition(transition).fire(marking)
-        marking = after_one
+        before_one, marking = marking, net.transition(transition).fire(marking)
         case.marking = dict(marking)
         record_event(
             case, EventType.TRANSITION_FIRED, task=transition, before=before_one, after=marking
@@ -305,10 +304,10 @@ def _cancel_emptied(case: Case, net: CaseNet, transition: str) -> None:
     for item in running.order_by("started_at", "id"):
         counted[item.task] += 1
         if counted[item.task] > marking.get(f"running:{item.task}"):
-            cancel_work_item(case, item, transition)
+            _cancel(case, item, transition)
 
 
-def cancel_work_item(case: Case, item: WorkItem, by: str) -> None:
+def _cancel(case: Case, item: WorkItem, by: str) -> None:
     """Ends a running item the transition `by` cancelled; the shared-area interruptions it
     caused end as if it had completed. An operator's leaves the tablets; a cobot's step not
     yet sent leaves the queue, one on the cobot is not stopped (a person stops a cobot)."""

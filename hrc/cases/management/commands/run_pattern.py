@@ -40,7 +40,8 @@ class Command(BaseCommand):
         )  # fmt: skip
         parser.add_argument(
             "--time-scale", type=float, default=0.05,
-            help="Simulated time per real second: 0.05 runs twenty times faster, 0 takes no time.",
+            help="Simulated time per real second (steps, operators and timers): 0.05 runs twenty "
+            "times faster, 0 takes no time.",
         )  # fmt: skip
         parser.add_argument("--json", action="store_true", help="One JSON event per line.")
         parser.add_argument("--timeout", type=float, default=600.0, help="Give up after (s).")
