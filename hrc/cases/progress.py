@@ -295,16 +295,25 @@ def _close(case: Case, item: WorkItem, state: WorkItemState) -> None:
 def _cancel_emptied(case: Case, net: CaseNet, transition: str) -> None:
     """Cancels the running items whose task the firing of `transition` emptied (its `cancels`):
     an item counts while the marking's `running:<task>` has a token for it, the earliest
-    started first. Call right after the firing, holding the case row lock."""
-    if not net.transition(transition).resets:
+    started first. Items not started whose input it emptied are withdrawn, saying so. Call
+    right after the firing, holding the case row lock."""
+    resets = set(net.transition(transition).resets)
+    if not resets:
         return
     marking = Marking(case.marking)
     counted: Counter[str] = Counter()
-    running = WorkItem.objects.filter(case=case, state=WorkItemState.RUNNING)
-    for item in running.order_by("started_at", "id"):
-        counted[item.task] += 1
-        if counted[item.task] > marking.get(f"running:{item.task}"):
-            _cancel(case, item, transition)
+    items = WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES)
+    for item in items.order_by("started_at", "id"):
+        if item.state == WorkItemState.RUNNING:
+            counted[item.task] += 1
+            if counted[item.task] > marking.get(f"running:{item.task}"):
+                _cancel(case, item, transition)
+        elif not net.can_start(marking, item.task) and resets & _inputs(net, item.task):
+            _withdraw(case, item, f"{net.labels.get(transition, transition)} cancelled it")
+
+
+def _inputs(net: CaseNet, task: str) -> set[str]:
+    return {place for place, _ in net.transition(f"start:{task}").pre}
 
 
 def _cancel(case: Case, item: WorkItem, by: str) -> None:

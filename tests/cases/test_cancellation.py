@@ -7,6 +7,8 @@ from typing import Any
 
 import pytest
 from django.contrib.auth.models import User
+from django.test import Client
+from django.urls import reverse
 
 from hrc.cases import jobs, services, timers
 from hrc.cases.choices import CaseStatus, EventType, JobState, WorkItemState
@@ -152,3 +154,30 @@ def test_a_step_not_yet_sent_leaves_the_queue(picking: Case) -> None:
     pick = WorkItem.objects.get(case=picking, task="tc1")
     assert pick.state == WorkItemState.WITHDRAWN  # only offered: its input emptied
     assert Job.objects.get(work_item=pick).state == JobState.CANCELLED
+    assert _events(picking, EventType.TASK_WITHDRAWN) == [
+        (EventType.TASK_WITHDRAWN, "tc1", {"why": "pick late cancelled it"})
+    ]
+
+
+def test_the_case_history_shows_the_task_cancelled_and_by_what(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    case = _start(
+        organisation, engineer, patterns.inspection_with_deadline(),
+        {"o": {"users": [operator.pk]}},
+    )  # fmt: skip
+    services.start_work_item(factories.open_work_item(case, "to1"), user=operator)
+    _ring(case)
+    client = Client()
+    client.force_login(engineer)
+
+    page = client.get(reverse("cases:case-detail", args=[case.pk])).content.decode()
+
+    def row(event: str) -> str:
+        return page[page.index(f'data-type="{event}"') :].split("</tr>")[0]
+
+    assert "Task cancelled" in row("task-cancelled")
+    assert "inspect <code" in row("task-cancelled")
+    assert "by: late" in row("task-cancelled")
+    assert "Timer fired" in row("timer-fired")
+    assert "running:to1 −1" in row("timer-fired")  # the timer's firing emptied it
