@@ -63,10 +63,10 @@ class Case(models.Model):
     last_seq = models.PositiveIntegerField(
         default=0, help_text="The sequence number of the case's latest event."
     )
-    time_scale = models.FloatField(
+    timer_scale = models.FloatField(
         default=1.0,
         help_text="Its timers wait their duration times this: 1 on a plant, less in a "
-        "simulation that runs faster than real time (run_pattern --time-scale).",
+        "simulation that runs faster than real time (run_pattern --time-scale, --timer-scale).",
     )
 
     class Meta:
@@ -134,7 +134,9 @@ class CaseTimer(models.Model):
     transition = models.CharField(max_length=200, help_text="The timer transition's id.")
     state = models.CharField(max_length=10, choices=TimerState.choices, default=TimerState.ARMED)
     armed_at = models.DateTimeField(auto_now_add=True)
-    due_at = models.DateTimeField(help_text="When it rings: armed_at + duration × time scale.")
+    due_at = models.DateTimeField(
+        help_text="When it rings: armed_at + duration × the case's timer scale."
+    )
     ended_at = models.DateTimeField(null=True, blank=True, help_text="Fired or disarmed.")
 
     class Meta:

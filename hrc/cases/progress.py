@@ -464,7 +464,7 @@ def take_message(case: Case, net: CaseNet, message_pk: int) -> bool:
 
 def arm_timers(case: Case, net: CaseNet) -> None:
     """Arms each timer transition the marking enables and no armed timer stands for (due after
-    its duration times the case's time scale; its doorbell rings then), and disarms the armed
+    its duration times the case's timer scale; its doorbell rings then), and disarms the armed
     ones whose transition it no longer enables. One that stays enabled keeps its due time.
     Call while holding the case row lock."""
     if not net.timers:
@@ -476,7 +476,7 @@ def arm_timers(case: Case, net: CaseNet) -> None:
             timer.state, timer.ended_at = TimerState.DISARMED, now
             timer.save(update_fields=["state", "ended_at"])
     for transition, milliseconds in waiting.items():
-        seconds = milliseconds / 1000 * case.time_scale
+        seconds = milliseconds / 1000 * case.timer_scale
         timer = CaseTimer.objects.create(
             case=case, transition=transition, due_at=now + dt.timedelta(seconds=seconds)
         )

@@ -157,6 +157,8 @@ class Simulation:
     document: Mapping[str, Any]
     workdir: Path
     time_scale: float = 0.05
+    # Timers' own scale, where the model's timers are far longer than its steps (hours).
+    timer_scale: float | None = None
     operator_delay: tuple[float, float] = (0.2, 1.0)  # seconds, times time_scale
     inline: bool = True
     seed: int | None = None
@@ -332,7 +334,7 @@ class Simulation:
                 data = variant.data
             case = services.start_case(
                 self.version, started_by=None, actor_mapping=mapping, data=data,
-                time_scale=self.time_scale,
+                timer_scale=self.time_scale if self.timer_scale is None else self.timer_scale,
             )  # fmt: skip
             started.append(case.pk)
             self._started += 1

@@ -2,7 +2,7 @@
 
 A timer transition fires once it has been enabled for its duration without
 interruption. Every change of a case's marking arms the timers it newly enables
-(a CaseTimer row, due at its duration times the case's time scale) and disarms
+(a CaseTimer row, due at its duration times the case's timer scale) and disarms
 those it no longer enables, in the transaction that changes the marking; after
 commit a delayed task rings the timer's doorbell at its due time. The row is the
 truth: a lost doorbell costs only latency (the sweeper rings overdue timers), and

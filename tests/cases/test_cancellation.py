@@ -38,7 +38,7 @@ def _start(
 ) -> Case:
     version = factories.make_version(organisation, published_by=engineer, draft=document)
     # Time scale 0: the timers are due at once; the tests ring them (no worker here).
-    return services.start_case(version, started_by=engineer, actor_mapping=mapping, time_scale=0)
+    return services.start_case(version, started_by=engineer, actor_mapping=mapping, timer_scale=0)
 
 
 def _ring(case: Case) -> None:

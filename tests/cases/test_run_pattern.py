@@ -186,12 +186,13 @@ def test_an_imported_bpmn_process_whose_branches_end_apart_completes(tmp_path: P
 
 @pytest.mark.django_db(transaction=True)
 def test_a_timer_rings_and_cancels_a_running_step_in_a_simulated_run(tmp_path: Path) -> None:
-    """The deadline (0.5 s, times the time scale) passes while the cobot's pick (2 s) runs: the
-    pick is cancelled but runs to its end on the cobot, which only then puts the part back."""
+    """The deadline (an hour, times the timer scale: 0.36 s) passes while the cobot's pick (2 s,
+    times the time scale: 1 s) runs: the pick is cancelled but runs to its end on the cobot,
+    which only then puts the part back."""
     path = tmp_path / "deadline.json"
-    path.write_text(json.dumps(patterns.pick_with_deadline("PT0.5S")))
+    path.write_text(json.dumps(patterns.pick_with_deadline("PT1H")))
 
-    events = run_pattern(path, "--time-scale", "0.5", "--seed", "1")
+    events = run_pattern(path, "--time-scale", "0.5", "--timer-scale", "0.0001", "--seed", "1")
 
     trace = [(e["event"], e["task"]) for e in events]
     assert trace[-1] == ("case-completed", None)

@@ -36,10 +36,10 @@ def deadline_version(organisation: Organisation, engineer: User) -> PatternVersi
     )
 
 
-def _start(version: PatternVersion, operator: User, time_scale: float = 1.0) -> Case:
+def _start(version: PatternVersion, operator: User, timer_scale: float = 1.0) -> Case:
     return services.start_case(
         version, started_by=operator, actor_mapping={"o": {"users": [operator.pk]}},
-        time_scale=time_scale,
+        timer_scale=timer_scale,
     )  # fmt: skip
 
 
@@ -56,12 +56,12 @@ def _fired(case: Case) -> list[str]:
 
 
 @pytest.mark.django_db
-def test_a_timer_is_armed_for_its_duration_times_the_case_time_scale(
+def test_a_timer_is_armed_for_its_duration_times_the_case_timer_scale(
     deadline_version: PatternVersion, operator: User
 ) -> None:
     before = timezone.now()
     plant = _timer(_start(deadline_version, operator))
-    simulated = _timer(_start(deadline_version, operator, time_scale=0.01))
+    simulated = _timer(_start(deadline_version, operator, timer_scale=0.01))
 
     assert plant.state == simulated.state == TimerState.ARMED
     waits = (plant.due_at - before).total_seconds()
@@ -73,7 +73,7 @@ def test_a_timer_is_armed_for_its_duration_times_the_case_time_scale(
 def test_a_task_done_in_time_disarms_the_timer(
     deadline_version: PatternVersion, operator: User
 ) -> None:
-    case = _start(deadline_version, operator, time_scale=0)
+    case = _start(deadline_version, operator, timer_scale=0)
     item = factories.open_work_item(case, "to1")
     services.start_work_item(item, user=operator)
     services.complete_work_item(item, user=operator)
@@ -90,7 +90,7 @@ def test_a_task_done_in_time_disarms_the_timer(
 def test_a_due_timer_fires_once_and_the_case_goes_on(
     deadline_version: PatternVersion, operator: User
 ) -> None:
-    case = _start(deadline_version, operator, time_scale=0)
+    case = _start(deadline_version, operator, timer_scale=0)
     timer = _timer(case)
 
     assert timers.ring_timer(timer.pk) is True
@@ -132,7 +132,7 @@ def test_an_early_doorbell_fires_nothing_and_rings_again_when_due(
 def test_a_suspended_case_timer_waits_until_the_case_resumes(
     deadline_version: PatternVersion, operator: User
 ) -> None:
-    case = _start(deadline_version, operator, time_scale=0)
+    case = _start(deadline_version, operator, timer_scale=0)
     services.suspend_case(case, by=operator)
 
     assert timers.ring_timer(_timer(case).pk) is False
@@ -146,7 +146,7 @@ def test_a_suspended_case_timer_waits_until_the_case_resumes(
 def test_a_cancelled_case_disarms_its_timers(
     deadline_version: PatternVersion, operator: User
 ) -> None:
-    case = _start(deadline_version, operator, time_scale=0)
+    case = _start(deadline_version, operator, timer_scale=0)
     services.cancel_case(case, by=operator)
 
     timer = _timer(case)
@@ -176,7 +176,7 @@ def test_a_real_worker_rings_the_timer_when_it_is_due(
     start_worker: Callable[..., WorkerProcess],
 ) -> None:
     start_worker()
-    case = _start(deadline_version, operator, time_scale=1.5 / FIVE_MINUTES)  # due in 1.5 s
+    case = _start(deadline_version, operator, timer_scale=1.5 / FIVE_MINUTES)  # due in 1.5 s
     timer = _timer(case)
 
     until(lambda: _fired(case), timeout=30, message="the timer never rang")
@@ -210,7 +210,7 @@ def test_inline_runs_ring_timers_on_their_pool(
     pool = ThreadPoolExecutor(max_workers=2)
     try:
         with dispatch.run_inline(pool):
-            case = _start(deadline_version, operator, time_scale=0.3 / FIVE_MINUTES)
+            case = _start(deadline_version, operator, timer_scale=0.3 / FIVE_MINUTES)
             until(lambda: _fired(case), timeout=10, message="the timer never rang inline")
     finally:
         pool.shutdown(wait=True)
