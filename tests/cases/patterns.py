@@ -226,3 +226,14 @@ def pick_with_deadline(timer: str = "PT0.5S") -> dict[str, Any]:
     ]  # fmt: skip
     places = ["p0", "p1", "p2", "p3", "p4", "w", "p_end"]
     return _document("Pick with a deadline", _process(tasks, arcs, places), [])
+
+
+def cool_down_then_inspect(timer: str = "PT10M") -> dict[str, Any]:
+    """The part cools down (`cool_down`, a timer: BPMN's intermediate timer event) before an
+    operator inspects it: at the start the case offers nothing and only waits."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "cool_down", "label": "cooled down", "timer": timer},
+        {"id": "to1", "performer": "o", "label": "inspect"},
+    ]
+    arcs = [["p0", "cool_down"], ["cool_down", "p1"], ["p1", "to1"], ["to1", "p2"]]
+    return _operators_only("Cool down, then inspect", _process(tasks, arcs, ["p0", "p1", "p2"]))

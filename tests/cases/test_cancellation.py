@@ -12,6 +12,7 @@ from django.urls import reverse
 
 from hrc.cases import jobs, services, timers
 from hrc.cases.choices import CaseStatus, EventType, JobState, WorkItemState
+from hrc.cases.messages import receive_message
 from hrc.cases.models import Case, CaseEvent, CaseTimer, Incident, Job, WorkItem
 from hrc.cobots.drivers.base import CommandRefused
 from hrc.cobots.models import Cobot
@@ -181,3 +182,25 @@ def test_the_case_history_shows_the_task_cancelled_and_by_what(
     assert "by: late" in row("task-cancelled")
     assert "Timer fired" in row("timer-fired")
     assert "running:to1 −1" in row("timer-fired")  # the timer's firing emptied it
+
+
+def test_a_message_transition_cancels_the_running_task_it_interrupts(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    """An interrupting message boundary event: `late` waits for "abort" instead of a time."""
+    document = patterns.inspection_with_deadline()
+    [late] = [t for t in document["processes"][0]["transitions"] if t["id"] == "late"]
+    del late["timer"]
+    late["message"] = {"name": "abort", "correlation": {"case": "case.id"}}
+    case = _start(organisation, engineer, document, {"o": {"users": [operator.pk]}})
+    inspect = factories.open_work_item(case, "to1")
+    services.start_work_item(inspect, user=operator)
+
+    receive_message(organisation, message_id="m1", name="abort", correlation={"case": case.pk})
+
+    inspect.refresh_from_db()
+    assert inspect.state == WorkItemState.CANCELLED
+    assert _events(case, EventType.TASK_CANCELLED) == [
+        (EventType.TASK_CANCELLED, "to1", {"by": "late"})
+    ]
+    assert factories.open_work_item(case, "to_rework")

@@ -216,3 +216,18 @@ def test_inline_runs_ring_timers_on_their_pool(
         pool.shutdown(wait=True)
         connections.close_all()
     assert factories.open_work_item(case, "to_rework")
+
+
+@pytest.mark.django_db
+def test_a_case_waiting_only_for_a_timer_runs_on_until_it_rings(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    version = factories.make_version(
+        organisation, published_by=engineer, draft=patterns.cool_down_then_inspect()
+    )
+    case = _start(version, operator, timer_scale=0)
+
+    assert case.status == CaseStatus.RUNNING  # nothing to offer is no fault while a timer waits
+    assert not case.work_items.exists()
+    assert timers.ring_timer(CaseTimer.objects.get(case=case, transition="cool_down").pk)
+    assert factories.open_work_item(case, "to1")
