@@ -231,3 +231,19 @@ def test_a_case_waiting_only_for_a_timer_runs_on_until_it_rings(
     assert not case.work_items.exists()
     assert timers.ring_timer(CaseTimer.objects.get(case=case, transition="cool_down").pk)
     assert factories.open_work_item(case, "to1")
+
+
+@pytest.mark.django_db
+def test_the_admin_lists_timers_and_changes_none(
+    deadline_version: PatternVersion, operator: User, staff_client: Client
+) -> None:
+    case = _start(deadline_version, operator)
+    timer = _timer(case)
+
+    listing = staff_client.get(reverse("admin:cases_casetimer_changelist"))
+    assert listing.status_code == 200
+    assert "late" in listing.content.decode()
+    assert staff_client.get(reverse("admin:cases_casetimer_add")).status_code == 403
+    delete = reverse("admin:cases_casetimer_delete", args=[timer.pk])
+    assert staff_client.post(delete, {"post": "yes"}).status_code == 403
+    assert _timer(case).state == TimerState.ARMED
