@@ -61,6 +61,10 @@ MAX_ROUNDS = 10_000
 # How long a message waits for a case to take it: one from outside unless it says otherwise,
 # and every message a case sends.
 MESSAGE_TTL_SECONDS = 3600
+# A timer's doorbell is sent only when it is due within this: Redis hands a message not
+# acknowledged within an hour (its visibility timeout) to a worker again, so a doorbell held
+# for days would come back every hour. The sweeper rings the later ones, a sweep late at most.
+DOORBELL_HORIZON_SECONDS = 600
 
 
 # The locks every writer takes first -------------------------------------------------
@@ -480,6 +484,14 @@ def arm_timers(case: Case, net: CaseNet) -> None:
         timer = CaseTimer.objects.create(
             case=case, transition=transition, due_at=now + dt.timedelta(seconds=seconds)
         )
+        ring_timer_on_commit(timer)
+
+
+def ring_timer_on_commit(timer: CaseTimer) -> None:
+    """Rings the timer's doorbell at its due time once this transaction commits; one due beyond
+    DOORBELL_HORIZON_SECONDS is left to the sweeper (timers.sweep_timers)."""
+    seconds = max((timer.due_at - timezone.now()).total_seconds(), 0.0)
+    if seconds <= DOORBELL_HORIZON_SECONDS:
         dispatch.send_on_commit(Task.RING_TIMER, timer.pk, countdown=seconds)
 
 
@@ -675,8 +687,8 @@ def ring_for_due_timers_on_commit(case: Case) -> None:
     """Rings the doorbell of each armed timer of the case that is due (it waited while the case
     was suspended)."""
     due = CaseTimer.objects.filter(case=case, state=TimerState.ARMED, due_at__lte=timezone.now())
-    for timer_id in due.values_list("pk", flat=True):
-        dispatch.send_on_commit(Task.RING_TIMER, timer_id)
+    for timer in due:
+        ring_timer_on_commit(timer)
 
 
 def ring_for_queued_jobs_on_commit(case: Case) -> None:

@@ -5,8 +5,9 @@ interruption. Every change of a case's marking arms the timers it newly enables
 (a CaseTimer row, due at its duration times the case's timer scale) and disarms
 those it no longer enables, in the transaction that changes the marking; after
 commit a delayed task rings the timer's doorbell at its due time. The row is the
-truth: a lost doorbell costs only latency (the sweeper rings overdue timers), and
-a second one finds the timer fired and does nothing, so a timer fires at most once.
+truth: a lost doorbell costs only latency (the sweeper rings overdue timers, and
+those due too far ahead for a doorbell), and a second one finds the timer fired and
+does nothing, so a timer fires at most once.
 """
 
 from __future__ import annotations
@@ -40,9 +41,8 @@ def ring_timer(timer_id: int) -> bool:
         timer = CaseTimer.objects.get(pk=timer_id)  # the case row lock guards its timers
         if timer.state != TimerState.ARMED or case.status != CaseStatus.RUNNING:
             return False
-        early = (timer.due_at - timezone.now()).total_seconds()
-        if early > 0:
-            dispatch.send_on_commit(Task.RING_TIMER, timer.pk, countdown=early)
+        if timer.due_at > timezone.now():
+            progress.ring_timer_on_commit(timer)
             return False
         net = case_net(case.version)
         try:
@@ -54,8 +54,9 @@ def ring_timer(timer_id: int) -> bool:
 
 
 def sweep_timers() -> int:
-    """Rings again for the armed timers of running cases that are overdue: their doorbell was
-    lost (the broker or the server restarted). Returns how many."""
+    """Rings for the armed timers of running cases that are overdue: their doorbell was lost
+    (the broker or the server restarted), or they were due too far ahead to get one
+    (progress.DOORBELL_HORIZON_SECONDS). Returns how many."""
     overdue = list(
         CaseTimer.objects.filter(
             state=TimerState.ARMED, case__status=CaseStatus.RUNNING,

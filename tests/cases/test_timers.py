@@ -17,6 +17,7 @@ from pytest_django import DjangoCaptureOnCommitCallbacks
 
 from hrc.cases import dispatch, services, timers
 from hrc.cases.choices import CaseStatus, EventType, TimerState, WorkItemState
+from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, CaseEvent, CaseTimer
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
@@ -247,3 +248,40 @@ def test_the_admin_lists_timers_and_changes_none(
     delete = reverse("admin:cases_casetimer_delete", args=[timer.pk])
     assert staff_client.post(delete, {"post": "yes"}).status_code == 403
     assert _timer(case).state == TimerState.ARMED
+
+
+@pytest.mark.django_db
+def test_only_a_timer_due_soon_gets_a_doorbell_a_later_one_is_the_sweeper_s(
+    organisation: Organisation,
+    engineer: User,
+    operator: User,
+    monkeypatch: pytest.MonkeyPatch,
+    django_capture_on_commit_callbacks: DjangoCaptureOnCommitCallbacks,
+) -> None:
+    """Redis hands an unacknowledged message out again every hour: a doorbell held for a day
+    would come back 24 times."""
+    sent: list[tuple[str, tuple[object, ...], float]] = []
+
+    def record(task: str, args: tuple[object, ...], countdown: float) -> None:
+        sent.append((task, args, countdown))
+
+    monkeypatch.setattr(dispatch, "_send", record)
+    soon, later = (
+        factories.make_version(
+            organisation, published_by=engineer, draft=patterns.inspection_with_deadline(timer)
+        )
+        for timer in ("PT5M", "P1D")
+    )
+    with django_capture_on_commit_callbacks(execute=True):
+        soon_case, later_case = _start(soon, operator), _start(later, operator)
+
+    [(args, countdown)] = [(a, c) for task, a, c in sent if task == Task.RING_TIMER]
+    assert args == (_timer(soon_case).pk,)
+    assert FIVE_MINUTES - 5 < countdown <= FIVE_MINUTES
+
+    CaseTimer.objects.filter(case=later_case).update(
+        due_at=timezone.now() - dt.timedelta(seconds=5)
+    )
+    with django_capture_on_commit_callbacks(execute=True):
+        assert timers.sweep_timers() == 1
+    assert sent[-1] == (Task.RING_TIMER, (_timer(later_case).pk,), 0)
