@@ -495,7 +495,7 @@ def ring_timer_on_commit(timer: CaseTimer) -> None:
         dispatch.send_on_commit(Task.RING_TIMER, timer.pk, countdown=seconds)
 
 
-def ring_timer(case: Case, net: CaseNet, timer: CaseTimer) -> None:
+def fire_timer(case: Case, net: CaseNet, timer: CaseTimer) -> None:
     """Fires the timer's transition, then advances the case. Raises NotEnabled when the marking
     does not enable it. Call while holding the case row lock, with the timer armed and due;
     the caller saves the case."""

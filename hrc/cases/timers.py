@@ -46,7 +46,7 @@ def ring_timer(timer_id: int) -> bool:
             return False
         net = case_net(case.version)
         try:
-            progress.ring_timer(case, net, timer)
+            progress.fire_timer(case, net, timer)
         except NotEnabled:  # arm_timers keeps armed timers enabled; should that fail, disarm
             progress.arm_timers(case, net)
         case.save()
