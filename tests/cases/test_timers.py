@@ -185,7 +185,7 @@ def test_a_real_worker_rings_the_timer_when_it_is_due(
     timer.refresh_from_db()
     assert timer.ended_at is not None
     assert timer.ended_at >= timer.due_at
-    assert timer.ended_at - timer.armed_at >= dt.timedelta(seconds=1.5)
+    assert timer.ended_at - timer.armed_at >= dt.timedelta(seconds=1.4)  # not a moment early
     assert factories.open_work_item(case, "to_rework")
 
 
