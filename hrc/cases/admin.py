@@ -16,7 +16,7 @@ from django.db.models import QuerySet
 from django.http import HttpRequest
 
 from hrc.cases import services
-from hrc.cases.models import Case, CaseEvent, Incident, Job, Message, WorkItem
+from hrc.cases.models import Case, CaseEvent, CaseTimer, Incident, Job, Message, WorkItem
 from hrc.errors import Refusal
 
 # Generic for mypy only: Django's runtime classes are not subscriptable.
@@ -111,6 +111,14 @@ class JobAdmin(ReadOnlyAdmin):
     list_filter = ["state", "kind", "cobot", "device"]
     search_fields = ["=case__id", "cobot__name", "device__name"]
     list_select_related = ["cobot", "device", "case"]
+
+
+@admin.register(CaseTimer)
+class CaseTimerAdmin(ReadOnlyAdmin):
+    list_display = ["id", "case", "transition", "state", "armed_at", "due_at", "ended_at"]
+    list_filter = ["state"]
+    search_fields = ["=case__id", "transition"]
+    list_select_related = ["case"]
 
 
 @admin.register(Incident)

@@ -33,6 +33,9 @@ class WorkItemState(models.TextChoices):
     COMPLETED = "completed", "Completed"
     # Another task of a deferred choice started first, or the case ended.
     WITHDRAWN = "withdrawn", "Withdrawn"
+    # Stopped counting while it ran: a transition's `cancels` emptied its task. A cobot's step
+    # already on the cobot runs to its end (only a person stops a cobot); nothing follows from it.
+    CANCELLED = "cancelled", "Cancelled"
 
 
 OPEN_WORK_ITEM_STATES = frozenset(
@@ -80,6 +83,14 @@ class InterruptionMode(models.TextChoices):
 COMMANDED_MODES = (InterruptionMode.PAUSE, InterruptionMode.SLOW)
 
 
+class TimerState(models.TextChoices):
+    # Its transition is enabled; it rings at due_at unless the transition stops being enabled.
+    ARMED = "armed", "Armed"
+    FIRED = "fired", "Fired"
+    # Its transition stopped being enabled before it was due (another branch went first).
+    DISARMED = "disarmed", "Disarmed"
+
+
 class EventType(models.TextChoices):
     CASE_STARTED = "case-started", "Case started"
     CASE_SUSPENDED = "case-suspended", "Case suspended"
@@ -95,6 +106,10 @@ class EventType(models.TextChoices):
     TASK_STARTED = "task-started", "Task started"
     TASK_COMPLETED = "task-completed", "Task completed"
     TASK_WITHDRAWN = "task-withdrawn", "Task withdrawn"
+    # A running task stopped counting: the transition in its detail (`by`) cancelled it.
+    TASK_CANCELLED = "task-cancelled", "Task cancelled"
+    # The step of a cancelled task ended on its cobot; its outcome is kept, nothing fires.
+    CANCELLED_STEP_ENDED = "cancelled-step-ended", "Cancelled task's step ended"
     TASK_INTERRUPTED = "task-interrupted", "Task interrupted"
     TASK_RESUMED = "task-resumed", "Task resumed"
     # Refused (an operator) or held back (a cobot's step) while another task is in its shared area.
@@ -104,6 +119,8 @@ class EventType(models.TextChoices):
     # The case sent a message as a task completed or a transition fired (a "send" key).
     MESSAGE_SENT = "message-sent", "Message sent"
     MESSAGE_RECEIVED = "message-received", "Message received"
+    # A timer transition fired: it had been enabled for its duration without interruption.
+    TIMER_FIRED = "timer-fired", "Timer fired"
     STEP_RETRY = "step-retry", "Step will be retried"
     # A cobot step or device call failed for good: its error; an incident follows.
     STEP_FAILED = "step-failed", "Step failed"

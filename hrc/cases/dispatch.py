@@ -46,6 +46,7 @@ class Task(StrEnum):
     RESUME_COBOT = "hrc.cases.tasks.resume_cobot"
     PURGE_MESSAGES = "hrc.cases.tasks.purge_messages"
     DELIVER_MESSAGE = "hrc.cases.tasks.deliver_message"
+    RING_TIMER = "hrc.cases.tasks.ring_timer"
 
 
 def send_on_commit(task: Task, *args: Any, countdown: float = 0) -> None:

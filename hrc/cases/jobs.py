@@ -382,7 +382,11 @@ def finish_job(
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
         job.accepted_at = accepted_at or job.started_at
         job.save(update_fields=["state", "result", "ended_at", "accepted_at"])
-        if case.status in OPEN_CASE_STATUSES:
+        if job.work_item.state == WorkItemState.CANCELLED:
+            events.record_event(
+                case, EventType.CANCELLED_STEP_ENDED, item=job.work_item, detail={"result": result}
+            )
+        elif case.status in OPEN_CASE_STATUSES:
             progress.complete_cobot_task(case, case_net(case.version), job.work_item, result)
         case.save()
         _ring_for_next_on_commit(job)
@@ -453,14 +457,22 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
 
 
 def _ended_with_case(case: Case, job: Job) -> bool:
-    """A running job whose case ended meanwhile (cancelled, failed) ends too: cancelled, never
-    queued again, where it would stay listed for ever. True when it did.
+    """A running job whose case ended meanwhile (cancelled, failed), or whose task a transition
+    cancelled, ends too: cancelled, never queued again, where it would stay listed for ever (a
+    cancelled task's step: with an event saying how it ended). True when it did.
 
     Call while holding the case row lock."""
-    if case.status in OPEN_CASE_STATUSES:
+    cancelled = job.work_item.state == WorkItemState.CANCELLED
+    if case.status in OPEN_CASE_STATUSES and not cancelled:
         return False
     job.state, job.ended_at = JobState.CANCELLED, timezone.now()
     job.save()
+    if cancelled:
+        events.record_event(
+            case, EventType.CANCELLED_STEP_ENDED, item=job.work_item,
+            detail={"error": job.last_error or "its worker lost the job"},
+        )  # fmt: skip
+        case.save()
     _publish_queue(job)
     _ring_for_next_on_commit(job)
     return True

@@ -22,6 +22,7 @@ from hrc.cases.choices import (
     InterruptionMode,
     JobState,
     Resolution,
+    TimerState,
     WorkItemKind,
     WorkItemState,
 )
@@ -61,6 +62,11 @@ class Case(models.Model):
     ended_at = models.DateTimeField(null=True, blank=True)
     last_seq = models.PositiveIntegerField(
         default=0, help_text="The sequence number of the case's latest event."
+    )
+    timer_scale = models.FloatField(
+        default=1.0,
+        help_text="Its timers wait their duration times this: 1 on a plant, less in a "
+        "simulation that runs faster than real time (run_pattern --time-scale, --timer-scale).",
     )
 
     class Meta:
@@ -118,6 +124,35 @@ class WorkItem(models.Model):
 
     def __str__(self) -> str:
         return f"{self.label or self.task} ({self.state})"
+
+
+class CaseTimer(models.Model):
+    """A timer transition of a case, armed while it is enabled: it fires once it has been
+    enabled for its duration without interruption (progress.arm_timers, timers.ring_timer)."""
+
+    case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="timers")
+    transition = models.CharField(max_length=200, help_text="The timer transition's id.")
+    state = models.CharField(max_length=10, choices=TimerState.choices, default=TimerState.ARMED)
+    armed_at = models.DateTimeField(auto_now_add=True)
+    due_at = models.DateTimeField(
+        help_text="When it rings: armed_at + duration × the case's timer scale."
+    )
+    ended_at = models.DateTimeField(null=True, blank=True, help_text="Fired or disarmed.")
+
+    class Meta:
+        ordering = ["due_at", "id"]
+        constraints = [
+            # One armed timer per transition and case: two would fire it twice.
+            models.UniqueConstraint(
+                fields=["case", "transition"],
+                condition=Q(state="armed"),
+                name="case_timer_one_armed_per_transition",
+            )
+        ]
+        indexes = [models.Index(fields=["state", "due_at"])]
+
+    def __str__(self) -> str:
+        return f"timer {self.transition} of case {self.case_id} ({self.state})"
 
 
 class Job(models.Model):

@@ -13,6 +13,7 @@ row, then job row, then interruption row.
 from __future__ import annotations
 
 import datetime as dt
+from collections import Counter
 from collections.abc import Mapping
 from typing import Any
 
@@ -31,12 +32,13 @@ from hrc.cases.choices import (
     InterruptionMode,
     JobState,
     Resolution,
+    TimerState,
     WorkItemKind,
     WorkItemState,
 )
 from hrc.cases.dispatch import Task
 from hrc.cases.events import open_incident, record_event
-from hrc.cases.models import Case, Incident, Interruption, Job, Message, WorkItem
+from hrc.cases.models import Case, CaseTimer, Incident, Interruption, Job, Message, WorkItem
 from hrc.cases.selectors import performable_by
 from hrc.engine.commands import cobot_command
 from hrc.engine.petri import Marking
@@ -59,6 +61,10 @@ MAX_ROUNDS = 10_000
 # How long a message waits for a case to take it: one from outside unless it says otherwise,
 # and every message a case sends.
 MESSAGE_TTL_SECONDS = 3600
+# A timer's doorbell is sent only when it is due within this: Redis hands a message not
+# acknowledged within an hour (its visibility timeout) to a worker again, so a doorbell held
+# for days would come back every hour. The sweeper rings the later ones, a sweep late at most.
+DOORBELL_HORIZON_SECONDS = 600
 
 
 # The locks every writer takes first -------------------------------------------------
@@ -124,9 +130,9 @@ def advance(case: Case, net: CaseNet) -> None:
 
     Silent transitions fire, buffered messages are taken, cobot tasks whose
     step is done complete once their func constraints allow; then the case
-    completes, or tasks that became startable are offered and those that
-    stopped being startable are withdrawn. Call while holding the case row
-    lock; the caller saves the case.
+    completes, or timers are armed and disarmed, tasks that became startable
+    are offered and those that stopped being startable are withdrawn. Call
+    while holding the case row lock; the caller saves the case.
     """
     if case.status not in OPEN_CASE_STATUSES:
         return
@@ -144,6 +150,7 @@ def advance(case: Case, net: CaseNet) -> None:
     if net.is_final(marking):
         end_case(case, CaseStatus.COMPLETED, EventType.CASE_COMPLETED, None, {})
         return
+    arm_timers(case, net)
     if case.status == CaseStatus.RUNNING:
         _offer_and_withdraw(case, net, marking)
 
@@ -153,12 +160,12 @@ def _settle(case: Case, net: CaseNet) -> bool:
     after, fired = net.settle(before, case.data)
     marking = before
     for transition in fired:
-        after_one = net.transition(transition).fire(marking)
-        record_event(
-            case, EventType.TRANSITION_FIRED, task=transition, before=marking, after=after_one
-        )
-        marking = after_one
+        before_one, marking = marking, net.transition(transition).fire(marking)
         case.marking = dict(marking)
+        record_event(
+            case, EventType.TRANSITION_FIRED, task=transition, before=before_one, after=marking
+        )
+        _cancel_emptied(case, net, transition)
         if transition in net.sends:
             send_message(case, _outgoing(case, net, transition), transition)
     case.marking = dict(after)
@@ -199,7 +206,12 @@ def _offer_and_withdraw(case: Case, net: CaseNet, marking: Marking) -> None:
     for task in net.startable(marking):
         if task not in open_items:
             _offer(case, net, task)
-    if not startable and not open_items and not net.waiting_messages(marking):
+    if (
+        not startable
+        and not open_items
+        and not net.waiting_messages(marking)
+        and not net.waiting_timers(marking)
+    ):
         fail_case(
             case,
             f"The case cannot go on: nothing can start in marking {dict(marking)} "
@@ -262,11 +274,19 @@ def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> 
 
 
 def _withdraw(case: Case, item: WorkItem, why: str) -> None:
+    _close(case, item, WorkItemState.WITHDRAWN)
+    record_event(case, EventType.TASK_WITHDRAWN, item=item, detail={"why": why})
+
+
+def _close(case: Case, item: WorkItem, state: WorkItemState) -> None:
+    """Ends an open item that did not complete: its jobs not yet sent leave the queue, a func
+    hold on its cobot ends, its open incidents are resolved as cancelled. A step on its cobot
+    runs on (jobs.finish_job records how it ended)."""
     if item.state == WorkItemState.RUNNING and item.kind != WorkItemKind.OPERATOR:
         held = Job.objects.filter(work_item=item, state=JobState.SUCCEEDED).first()
-        if held is not None:  # the case ends while its func constraint holds the cobot
+        if held is not None:  # the item ends while its func constraint holds the cobot
             _end_hold(held)
-    item.state, item.ended_at = WorkItemState.WITHDRAWN, timezone.now()
+    item.state, item.ended_at = state, timezone.now()
     item.save(update_fields=["state", "ended_at"])
     Job.objects.filter(work_item=item, state__in=[JobState.QUEUED, JobState.FAILED]).update(
         state=JobState.CANCELLED, ended_at=item.ended_at
@@ -274,7 +294,41 @@ def _withdraw(case: Case, item: WorkItem, why: str) -> None:
     Incident.objects.filter(work_item=item, resolved_at__isnull=True).update(
         resolved_at=item.ended_at, resolution=Resolution.CANCEL
     )
-    record_event(case, EventType.TASK_WITHDRAWN, item=item, detail={"why": why})
+
+
+def _cancel_emptied(case: Case, net: CaseNet, transition: str) -> None:
+    """Cancels the running items whose task the firing of `transition` emptied (its `cancels`):
+    an item counts while the marking's `running:<task>` has a token for it, the earliest
+    started first. Items not started whose input it emptied are withdrawn, saying so. Call
+    right after the firing, holding the case row lock."""
+    resets = set(net.transition(transition).resets)
+    if not resets:
+        return
+    marking = Marking(case.marking)
+    counted: Counter[str] = Counter()
+    items = WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES)
+    for item in items.order_by("started_at", "id"):
+        if item.state == WorkItemState.RUNNING:
+            counted[item.task] += 1
+            if counted[item.task] > marking.get(f"running:{item.task}"):
+                _cancel(case, item, transition)
+        elif not net.can_start(marking, item.task) and resets & _inputs(net, item.task):
+            _withdraw(case, item, f"{net.labels.get(transition, transition)} cancelled it")
+
+
+def _inputs(net: CaseNet, task: str) -> set[str]:
+    return {place for place, _ in net.transition(f"start:{task}").pre}
+
+
+def _cancel(case: Case, item: WorkItem, by: str) -> None:
+    """Ends a running item the transition `by` cancelled; the shared-area interruptions it
+    caused end as if it had completed. An operator's leaves the tablets; a cobot's step not
+    yet sent leaves the queue, one on the cobot is not stopped (a person stops a cobot)."""
+    _close(case, item, WorkItemState.CANCELLED)
+    record_event(case, EventType.TASK_CANCELLED, item=item, detail={"by": by})
+    # What it kept out of or paused in a shared area goes on, as when it completes. A pause
+    # of its own cobot stays until the task beside it ends: that step is not over.
+    _end_interruptions(case, Q(by_work_item=item))
 
 
 def start_task(case: Case, net: CaseNet, item: WorkItem, user: User | None) -> None:
@@ -389,6 +443,7 @@ def take_buffered_message(case: Case, net: CaseNet, only: int | None = None) -> 
                     case, EventType.MESSAGE_RECEIVED, task=transition, before=before, after=after,
                     detail={"message": message.message_id, "name": message.name},
                 )  # fmt: skip
+                _cancel_emptied(case, net, transition)
                 if transition in net.sends:  # a RuntimeFault fails the case (advance, take)
                     send_message(case, _outgoing(case, net, transition), transition)
                 return True
@@ -406,6 +461,68 @@ def take_message(case: Case, net: CaseNet, message_pk: int) -> bool:
     if taken:
         advance(case, net)
     return taken
+
+
+# Timers ---------------------------------------------------------------------------------
+
+
+def arm_timers(case: Case, net: CaseNet) -> None:
+    """Arms each timer transition the marking enables and no armed timer stands for (due after
+    its duration times the case's timer scale; its doorbell rings then), and disarms the armed
+    ones whose transition it no longer enables. One that stays enabled keeps its due time.
+    Call while holding the case row lock."""
+    if not net.timers:
+        return  # most patterns: no query
+    waiting = dict(net.waiting_timers(Marking(case.marking)))
+    now = timezone.now()
+    for timer in CaseTimer.objects.filter(case=case, state=TimerState.ARMED):
+        if waiting.pop(timer.transition, None) is None:
+            timer.state, timer.ended_at = TimerState.DISARMED, now
+            timer.save(update_fields=["state", "ended_at"])
+    for transition, milliseconds in waiting.items():
+        seconds = milliseconds / 1000 * case.timer_scale
+        timer = CaseTimer.objects.create(
+            case=case, transition=transition, due_at=now + dt.timedelta(seconds=seconds)
+        )
+        ring_timer_on_commit(timer)
+
+
+def ring_timer_on_commit(timer: CaseTimer) -> None:
+    """Rings the timer's doorbell at its due time once this transaction commits; one due beyond
+    DOORBELL_HORIZON_SECONDS is left to the sweeper (timers.sweep_timers)."""
+    seconds = max((timer.due_at - timezone.now()).total_seconds(), 0.0)
+    if seconds <= DOORBELL_HORIZON_SECONDS:
+        dispatch.send_on_commit(Task.RING_TIMER, timer.pk, countdown=seconds)
+
+
+def fire_timer(case: Case, net: CaseNet, timer: CaseTimer) -> None:
+    """Fires the timer's transition, then advances the case. Raises NotEnabled when the marking
+    does not enable it. Call while holding the case row lock, with the timer armed and due;
+    the caller saves the case."""
+    before = Marking(case.marking)
+    after = net.ring(before, timer.transition)
+    case.marking = dict(after)
+    timer.state, timer.ended_at = TimerState.FIRED, timezone.now()
+    timer.save(update_fields=["state", "ended_at"])
+    record_event(
+        case, EventType.TIMER_FIRED, task=timer.transition, before=before, after=after,
+        detail={"armed_at": timer.armed_at.isoformat(), "due_at": timer.due_at.isoformat()},
+    )  # fmt: skip
+    _cancel_emptied(case, net, timer.transition)
+    if timer.transition in net.sends:
+        try:
+            send_message(case, _outgoing(case, net, timer.transition), timer.transition)
+        except RuntimeFault as fault:
+            fail_case(case, str(fault))
+            return
+    advance(case, net)
+
+
+def disarm_timers(case: Case) -> None:
+    """Disarms the case's armed timers (it ended). Call while holding the case row lock."""
+    CaseTimer.objects.filter(case=case, state=TimerState.ARMED).update(
+        state=TimerState.DISARMED, ended_at=timezone.now()
+    )
 
 
 def case_names(case: Case) -> dict[str, Any]:
@@ -566,6 +683,14 @@ def ring_for_next_job_on_commit(job_id: int, cobot_id: int) -> None:
     dispatch.send_on_commit_if(queued, Task.RUN_JOB, job_id)
 
 
+def ring_for_due_timers_on_commit(case: Case) -> None:
+    """Rings the doorbell of each armed timer of the case that is due (it waited while the case
+    was suspended)."""
+    due = CaseTimer.objects.filter(case=case, state=TimerState.ARMED, due_at__lte=timezone.now())
+    for timer in due:
+        ring_timer_on_commit(timer)
+
+
 def ring_for_queued_jobs_on_commit(case: Case) -> None:
     """Rings the doorbell of each cobot the case has queued work for."""
     for job_id in Job.objects.filter(case=case, state=JobState.QUEUED).values_list("pk", flat=True):
@@ -627,6 +752,7 @@ def end_case(case: Case, status: str, event: str, by: User | None, detail: dict[
     for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES):
         _withdraw(case, item, f"the case is {status}")
     _end_interruptions(case, Q())
+    disarm_timers(case)
     case.status, case.ended_at = status, timezone.now()
     record_event(case, event, user=by, detail=detail)
 

@@ -25,8 +25,23 @@ from django.db.models import (
 )
 from django.db.models.functions import Coalesce
 
-from hrc.cases.choices import OPEN_WORK_ITEM_STATES, JobState, WorkItemKind, WorkItemState
-from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, Message, WorkItem
+from hrc.cases.choices import (
+    OPEN_WORK_ITEM_STATES,
+    JobState,
+    TimerState,
+    WorkItemKind,
+    WorkItemState,
+)
+from hrc.cases.models import (
+    Case,
+    CaseEvent,
+    CaseTimer,
+    Incident,
+    Interruption,
+    Job,
+    Message,
+    WorkItem,
+)
 from hrc.cases.nets import case_net
 from hrc.engine.petri import Marking
 from hrc.organisations.models import Team
@@ -293,6 +308,11 @@ def interruptions_of(case: Case) -> QuerySet[Interruption]:
         .select_related("work_item", "by_work_item", "cobot")
         .order_by("started_at", "id")
     )
+
+
+def armed_timers_of(case: Case) -> QuerySet[CaseTimer]:
+    """The timers the case waits for, the first due first."""
+    return CaseTimer.objects.filter(case=case, state=TimerState.ARMED).order_by("due_at", "id")
 
 
 def messages_of(case: Case) -> QuerySet[Message]:

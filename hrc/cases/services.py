@@ -48,14 +48,16 @@ def start_case(
     actor_mapping: Mapping[str, Any] | None = None,
     data: Mapping[str, Any] | None = None,
     reference: str = "",
+    timer_scale: float = 1.0,
 ) -> Case:
     """Starts a case of a published version; the mapping overrides the version's defaults per actor,
-    `data` the pattern's initial data per key. Invalid when the version is retired, an actor is
-    unmapped or mapped outside the organisation, or a data key is not the pattern's or its type's.
+    `data` the pattern's initial data per key; its timers wait their duration times `timer_scale`
+    (below 1 in a simulation). Invalid when the version is retired, an actor is unmapped or
+    mapped outside the organisation, or a data key is not the pattern's or its type's.
     """
     return start_cases(
         version, started_by=started_by, actor_mapping=actor_mapping, data=data,
-        reference=reference, count=1,
+        reference=reference, count=1, timer_scale=timer_scale,
     )[0]  # fmt: skip
 
 
@@ -67,6 +69,7 @@ def start_cases(
     data: Mapping[str, Any] | None = None,
     reference: str = "",
     count: int = 1,
+    timer_scale: float = 1.0,
 ) -> list[Case]:
     """Starts `count` cases alike, all or none (start_case's checks, once)."""
     if version.retired_at is not None:
@@ -90,6 +93,7 @@ def start_cases(
                 organisation=organisation, version=version, marking=dict(net.initial),
                 data={**net.initial_data(), **(data or {})},  # the pattern's `data`, then the case's
                 actor_mapping=mapping, started_by=started_by, reference=reference,
+                timer_scale=timer_scale,
             )  # fmt: skip
             case = progress.lock_case(case.pk)
             record_event(case, EventType.CASE_STARTED, user=started_by, after=net.initial)
@@ -148,6 +152,7 @@ def resume_case(case: Case, *, by: User | None) -> Case:
         record_event(case, EventType.CASE_RESUMED, user=by)
         progress.advance(case, case_net(case.version))
         progress.ring_for_queued_jobs_on_commit(case)
+        progress.ring_for_due_timers_on_commit(case)
         case.save()
     return case
 

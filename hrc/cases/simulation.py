@@ -48,7 +48,7 @@ from django.contrib.auth.models import User
 from django.db import close_old_connections, connections
 from django.utils import timezone
 
-from hrc.cases import dispatch, jobs, services
+from hrc.cases import dispatch, jobs, services, timers
 from hrc.cases.choices import OPEN_CASE_STATUSES, CaseStatus, WorkItemKind, WorkItemState
 from hrc.cases.device_jobs import DEVICE_SESSION
 from hrc.cases.models import Case, CaseEvent, Incident, WorkItem
@@ -77,6 +77,10 @@ REPORTED = {
     # what a case's processes tell each other or other cases ("send" and "message" keys)
     "message-sent",
     "message-received",
+    # a timer transition fired (its duration times --time-scale); a running task it or another
+    # transition cancelled (a "cancels" key)
+    "timer-fired",
+    "task-cancelled",
 }
 MESSAGES = {"message-sent", "message-received"}
 FAILED = {"case-failed", "case-cancelled"}
@@ -153,6 +157,8 @@ class Simulation:
     document: Mapping[str, Any]
     workdir: Path
     time_scale: float = 0.05
+    # Timers' own scale, where the model's timers are far longer than its steps (hours).
+    timer_scale: float | None = None
     operator_delay: tuple[float, float] = (0.2, 1.0)  # seconds, times time_scale
     inline: bool = True
     seed: int | None = None
@@ -327,8 +333,9 @@ class Simulation:
                 mapping = {actor: self._binding(name) for actor, name in variant.actors.items()}
                 data = variant.data
             case = services.start_case(
-                self.version, started_by=None, actor_mapping=mapping, data=data
-            )
+                self.version, started_by=None, actor_mapping=mapping, data=data,
+                timer_scale=self.time_scale if self.timer_scale is None else self.timer_scale,
+            )  # fmt: skip
             started.append(case.pk)
             self._started += 1
         return started
@@ -373,6 +380,7 @@ class Simulation:
         while not self._stop.wait(0.5):
             try:
                 jobs.sweep()
+                timers.sweep_timers()
             finally:
                 close_old_connections()
         connections.close_all()

@@ -7,7 +7,7 @@ registered under its dispatch.Task name, which is how the cases app sends it.
 
 from celery import shared_task
 
-from hrc.cases import device_jobs, interruptions, jobs
+from hrc.cases import device_jobs, interruptions, jobs, timers
 from hrc.cases.dispatch import Task
 from hrc.cases.messages import deliver_sent_message, purge_expired_messages, sweep_sent_messages
 
@@ -24,7 +24,7 @@ def run_job(job_id: int) -> None:
 
 @shared_task(name=Task.SWEEP.value, ignore_result=True)
 def sweep() -> dict[str, int]:
-    return {**jobs.sweep(), "messages": sweep_sent_messages()}
+    return {**jobs.sweep(), "messages": sweep_sent_messages(), "timers": timers.sweep_timers()}
 
 
 @shared_task(name=Task.INTERRUPT_COBOT.value, ignore_result=True)
@@ -46,3 +46,9 @@ def purge_messages() -> int:
 def deliver_message(message_id: int) -> None:
     """Offers a message a case sent to the other cases, once its sender's transaction committed."""
     deliver_sent_message(message_id)
+
+
+@shared_task(name=Task.RING_TIMER.value, ignore_result=True)
+def ring_timer(timer_id: int) -> None:
+    """Fires a case's timer transition once it is due, unless it fired or was disarmed."""
+    timers.ring_timer(timer_id)

@@ -167,6 +167,10 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
             for line in drawing.constraints
         ],
         "work_rows": [work_row(item) for item in items],
+        "timers": [
+            WaitingTimer(timer.due_at, drawing.labels.get(timer.transition, timer.transition))
+            for timer in selectors.armed_timers_of(case)
+        ],
         "incidents": incidents,
         "interruptions": _interruption_rows(selectors.interruptions_of(case)),
         "case_messages": _message_rows(case, selectors.messages_of(case)),
@@ -192,6 +196,12 @@ def case_detail(request: HttpRequest, pk: int) -> HttpResponse:
         },
     }
     return render(request, "cases/case_detail.html", context)
+
+
+@dataclass(frozen=True)
+class WaitingTimer:
+    due_at: dt.datetime
+    label: str  # the timer transition's
 
 
 @dataclass(frozen=True)

@@ -155,3 +155,85 @@ def func_hold(supported_by_cobot: bool = False) -> dict[str, Any]:
         ]
         document["processes"][0]["actors"] = ["c", "c2"]
     return document
+
+
+def inspection_with_deadline(timer: str = "PT5M") -> dict[str, Any]:
+    """An operator inspects (to1) under a deadline: `late`, a timer on the watch place `w`,
+    cancels the inspection once it has waited `timer` and sends the part to rework (to_rework);
+    an inspection done in time takes the watch token back (`in_time`), which disarms it."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "split"},
+        {"id": "to1", "performer": "o", "label": "inspect"},
+        {"id": "in_time"},
+        {"id": "late", "label": "inspection late", "timer": timer, "cancels": ["to1", "p1", "p2"]},
+        {"id": "to_rework", "performer": "o", "label": "send to rework"},
+    ]
+    arcs = [
+        ["p0", "split"], ["split", "p1"], ["split", "w"], ["p1", "to1"], ["to1", "p2"],
+        ["p2", "in_time"], ["w", "in_time"], ["in_time", "p_end"],
+        ["w", "late"], ["late", "p3"], ["p3", "to_rework"], ["to_rework", "p_end"],
+    ]  # fmt: skip
+    places = ["p0", "p1", "p2", "p3", "w", "p_end"]
+    return _operators_only("Inspection with a deadline", _process(tasks, arcs, places))
+
+
+def terminate_on_alarm() -> dict[str, Any]:
+    """Two operators' branches: to1 (assemble) and to2 (check the alarm); once to2 is done,
+    `terminate` ends the case, cancelling to1 wherever it is (a BPMN terminate end event).
+    When to1 is done first, `join` ends it normally."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "split"},
+        {"id": "to1", "performer": "o", "label": "assemble"},
+        {"id": "to2", "performer": "o", "label": "check the alarm"},
+        {"id": "join"},
+        {"id": "terminate", "cancels": ["pa", "to1", "pa2"]},
+    ]
+    arcs = [
+        ["p0", "split"], ["split", "pa"], ["split", "pb"], ["pa", "to1"], ["to1", "pa2"],
+        ["pb", "to2"], ["to2", "pb2"], ["pa2", "join"], ["pb2", "join"], ["join", "p_end"],
+        ["pb2", "terminate"], ["terminate", "p_end"],
+    ]  # fmt: skip
+    places = ["p0", "pa", "pa2", "pb", "pb2", "p_end"]
+    return _operators_only("Terminate on alarm", _process(tasks, arcs, places))
+
+
+def _operators_only(name: str, process: dict[str, Any]) -> dict[str, Any]:
+    document = _document(name, {**process, "actors": ["o"]}, [])
+    document["actors"] = [{"id": "o", "type": "operator"}]
+    return document
+
+
+def pick_with_deadline(timer: str = "PT0.5S") -> dict[str, Any]:
+    """The cobot picks (tc1, a 2 s step) under a deadline: `late` (a timer) cancels the pick
+    while it runs; an operator clears the cell (to_clear) and the cobot puts the part back
+    (tc2), after the cancelled pick has ended on the cobot (it is not stopped). A pick done in
+    time ends the case at once (`in_time`)."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "split"},
+        {"id": "tc1", "performer": "c", "label": "pick", "task": {
+            "step": {"number": PICK}, "timeout": 30}},
+        {"id": "in_time"},
+        {"id": "late", "label": "pick late", "timer": timer, "cancels": ["tc1", "p1", "p2"]},
+        {"id": "to_clear", "performer": "o", "label": "clear the cell"},
+        {"id": "tc2", "performer": "c", "label": "put back", "task": {
+            "step": {"number": PICK}, "timeout": 30}},
+    ]  # fmt: skip
+    arcs = [
+        ["p0", "split"], ["split", "p1"], ["split", "w"], ["p1", "tc1"], ["tc1", "p2"],
+        ["p2", "in_time"], ["w", "in_time"], ["in_time", "p_end"],
+        ["w", "late"], ["late", "p3"], ["p3", "to_clear"], ["to_clear", "p4"],
+        ["p4", "tc2"], ["tc2", "p_end"],
+    ]  # fmt: skip
+    places = ["p0", "p1", "p2", "p3", "p4", "w", "p_end"]
+    return _document("Pick with a deadline", _process(tasks, arcs, places), [])
+
+
+def cool_down_then_inspect(timer: str = "PT10M") -> dict[str, Any]:
+    """The part cools down (`cool_down`, a timer: BPMN's intermediate timer event) before an
+    operator inspects it: at the start the case offers nothing and only waits."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "cool_down", "label": "cooled down", "timer": timer},
+        {"id": "to1", "performer": "o", "label": "inspect"},
+    ]
+    arcs = [["p0", "cool_down"], ["cool_down", "p1"], ["p1", "to1"], ["to1", "p2"]]
+    return _operators_only("Cool down, then inspect", _process(tasks, arcs, ["p0", "p1", "p2"]))

@@ -12,11 +12,13 @@ from typing import Any
 import pytest
 from django.core.management import CommandError, call_command
 
+from hrc.cases.models import CaseEvent
 from hrc.engine.bpmn import bpmn_to_document
 from hrc.engine.document import read_pattern
 from hrc.engine.execution import supporter_of
 from hrc.engine.model import Pattern
 from hrc.engine.runtime import CaseNet
+from tests.cases import patterns
 from tests.engine.test_completion import PARALLEL_ENDS
 
 EXAMPLES = sorted((Path(__file__).parents[2] / "hrc" / "patterns" / "examples").glob("*.json"))
@@ -180,3 +182,28 @@ def test_an_imported_bpmn_process_whose_branches_end_apart_completes(tmp_path: P
             "task-started b",
         ]
         assert trace[-1].startswith("case-completed")
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_timer_rings_and_cancels_a_running_step_in_a_simulated_run(tmp_path: Path) -> None:
+    """The deadline (an hour, times the timer scale: 0.36 s) passes while the cobot's pick (2 s,
+    times the time scale: 1 s) runs: the pick is cancelled but runs to its end on the cobot,
+    which only then puts the part back."""
+    path = tmp_path / "deadline.json"
+    path.write_text(json.dumps(patterns.pick_with_deadline("PT1H")))
+
+    events = run_pattern(path, "--time-scale", "0.5", "--timer-scale", "0.0001", "--seed", "1")
+
+    trace = [(e["event"], e["task"]) for e in events]
+    assert trace[-1] == ("case-completed", None)
+    assert ("timer-fired", "late") in trace
+    assert ("task-cancelled", "tc1") in trace
+    assert ("task-started", "tc1") in trace
+    assert ("task-completed", "tc1") not in trace
+    assert ("task-completed", "to_clear") in trace
+    assert ("task-completed", "tc2") in trace
+    [case] = {e["case"] for e in events}
+    log = CaseEvent.objects.filter(case_id=case).order_by("seq")
+    ended = log.get(type="cancelled-step-ended", task="tc1")
+    assert ended.detail["result"]["outcome"] == "ran"
+    assert ended.seq < log.get(type="task-started", task="tc2").seq

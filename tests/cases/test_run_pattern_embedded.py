@@ -20,6 +20,7 @@ from pathlib import Path
 import pytest
 
 from hrc.engine.document import read_pattern
+from tests.cases import patterns
 from tests.cases.test_run_pattern import EVENTS, Event, check_trace
 
 ROOT = Path(__file__).parents[2]
@@ -132,3 +133,26 @@ def test_each_example_and_use_case_completes_on_the_embedded_default(
     elapsed = run_and_check(path, embedded_environment(scratch), cases)
 
     print(f"{path.name}: {cases} case(s) in {elapsed:.1f} s")
+
+
+def test_a_timer_cancelling_a_running_step_completes_on_the_embedded_default(
+    scratch: Path, tmp_path: Path
+) -> None:
+    """SQLite and the command's own threads: the deadline rings while the pick runs, as on
+    PostgreSQL with workers (test_run_pattern.py)."""
+    path = tmp_path / "deadline.json"
+    path.write_text(json.dumps(patterns.pick_with_deadline("PT0.5S")))
+
+    result = subprocess.run(
+        [sys.executable, "manage.py", "run_pattern", str(path), "--simulate", "--json",
+         "--time-scale", "0.5", "--seed", "1", "--timeout", "120"],
+        cwd=ROOT, env=embedded_environment(scratch), capture_output=True, text=True, timeout=180,
+    )  # fmt: skip
+
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "Traceback" not in result.stderr, result.stderr[-3000:]
+    trace = [(e["event"], e["task"]) for e in map(json.loads, result.stdout.splitlines())]
+    assert ("timer-fired", "late") in trace
+    assert ("task-cancelled", "tc1") in trace
+    assert ("task-completed", "tc1") not in trace
+    assert trace[-1] == ("case-completed", None)

@@ -40,7 +40,13 @@ class Command(BaseCommand):
         )  # fmt: skip
         parser.add_argument(
             "--time-scale", type=float, default=0.05,
-            help="Simulated time per real second: 0.05 runs twenty times faster, 0 takes no time.",
+            help="Simulated time per real second (steps, operators and timers): 0.05 runs twenty "
+            "times faster, 0 takes no time.",
+        )  # fmt: skip
+        parser.add_argument(
+            "--timer-scale", type=float, default=None,
+            help="Simulated time per real second for timers alone (default: --time-scale): "
+            "a model whose timers wait hours runs in seconds.",
         )  # fmt: skip
         parser.add_argument("--json", action="store_true", help="One JSON event per line.")
         parser.add_argument("--timeout", type=float, default=600.0, help="Give up after (s).")
@@ -56,6 +62,8 @@ class Command(BaseCommand):
             raise CommandError("--cases must be 1 or more.")
         if options["time_scale"] < 0:
             raise CommandError("--time-scale must be 0 or more.")
+        if options["timer_scale"] is not None and options["timer_scale"] < 0:
+            raise CommandError("--timer-scale must be 0 or more.")
         # Its cases live in a scratch organisation, so right after cloning it may create and
         # migrate the embedded SQLite itself; a PostgreSQL database it only reports.
         ensure_migrated(migrate_sqlite=True)
@@ -64,6 +72,7 @@ class Command(BaseCommand):
             tempfile.TemporaryDirectory(prefix="hrc-run-pattern-") as workdir,
             Simulation(
                 document, Path(workdir), time_scale=options["time_scale"],
+                timer_scale=options["timer_scale"],
                 inline=options["workers"] == "inline", seed=options["seed"],
             ) as simulation,
         ):  # fmt: skip
