@@ -66,7 +66,9 @@ def translate(text: str, language: str | None = None) -> str | None:
 
 # XPath, BPMN's default expression language: the spec's `bpmn:getDataObject('name')` reads a
 # data object, as a JUEL name reads a variable.
-_DATA_OBJECT = re.compile(r"""bpmn:getDataObject\(\s*(?:'([A-Za-z_][A-Za-z0-9_]*)'|"([A-Za-z_][A-Za-z0-9_]*)")\s*\)""")
+_DATA_OBJECT = re.compile(
+    r"""bpmn:getDataObject\(\s*(?:'([A-Za-z_][A-Za-z0-9_]*)'|"([A-Za-z_][A-Za-z0-9_]*)")\s*\)"""
+)
 _XPATH_BOOLEAN = re.compile(r"\b(true|false)\(\s*\)")
 _XPATH_EQUALS = re.compile(r"(?<![!<>=])=(?!=)")
 
