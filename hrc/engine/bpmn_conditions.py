@@ -126,6 +126,23 @@ def data_defaults(guard: str) -> dict[str, object]:
     return defaults
 
 
+def compared_values(guard: str) -> dict[str, list[object]]:
+    """Each data key the guard compares with constants, and those constants in order: the
+    answers that steer the choice (`data.clarified == 'yes'` gives clarified: ['yes'])."""
+    values: dict[str, list[object]] = {}
+    for node in ast.walk(ast.parse(guard, mode="eval")):
+        if not isinstance(node, ast.Compare):
+            continue
+        operands = [node.left, *node.comparators]
+        constants = [o.value for o in operands if isinstance(o, ast.Constant)]
+        for operand in operands:
+            key = _data_key(operand)
+            if key is not None:
+                found = values.setdefault(key, [])
+                found += [value for value in constants if value not in found]
+    return values
+
+
 def _data_key(node: ast.AST) -> str | None:
     if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
         return node.attr if node.value.id == "data" else None

@@ -135,6 +135,8 @@ class FlowNode:
     """A message a task waits for: a silent message transition in front of it."""
     loop: Json | None = None
     """A standard loop: `{"guard": ...}` or `{"rewrite": ...}` on the step back."""
+    writes: list[str] = field(default_factory=list)
+    """A task's data outputs and the data objects it writes, by name."""
     copies: tuple[int, bool] = (1, False)
     """Multi-instance: (how many, in sequence)."""
     inclusive_join: "FlowNode | None" = None

@@ -10,7 +10,7 @@ from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
 from hrc.engine.check import check_pattern
 from hrc.engine.document import FormatError, read_pattern
 from hrc.engine.model import Pattern
-from hrc.engine.runtime import CaseNet
+from hrc.engine.runtime import CaseNet, apply_outputs
 from tests.engine.builders import document, process
 from tests.engine.test_bpmn import _arcs, bpmn, flows, refused
 
@@ -108,6 +108,48 @@ def test_an_xpath_condition_over_data_objects_becomes_a_guard_that_routes_the_ca
     )
     assert _run(pattern, {"approved": True, "state": "open"}) == ["pay"]
     assert _run(pattern, {"approved": False, "state": "open"}) == ["review"]
+
+
+def test_a_task_that_writes_the_data_a_condition_reads_asks_for_it_in_its_form() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><userTask id="check" name="Check">'
+        '<ioSpecification><dataOutput id="o1" name="approved"/></ioSpecification>'
+        "<dataOutputAssociation><targetRef>ref</targetRef></dataOutputAssociation></userTask>"
+        '<dataObject id="obj" name="verdict"/><dataObjectReference id="ref" dataObjectRef="obj"'
+        ' name="verdict"/>'
+        '<exclusiveGateway id="x"/><task id="pay"/><task id="ask"/><task id="drop"/>'
+        '<exclusiveGateway id="m"/><endEvent id="e"/>'
+        '<sequenceFlow id="yes" sourceRef="x" targetRef="pay"><conditionExpression>'
+        "${approved}</conditionExpression></sequenceFlow>"
+        '<sequenceFlow id="more" sourceRef="x" targetRef="ask"><conditionExpression>'
+        "${!approved &amp;&amp; verdict == 'unclear'}</conditionExpression></sequenceFlow>"
+        '<sequenceFlow id="no" sourceRef="x" targetRef="drop"><conditionExpression>'
+        "${!approved &amp;&amp; verdict == 'wrong'}</conditionExpression></sequenceFlow>"
+        + flows("f1: s -> check", "f2: check -> x", "f3: pay -> m", "f4: ask -> m")
+        + flows("f5: drop -> m", "f6: m -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    config = _transition(pattern, "check").extra["task"]
+
+    assert config["form"] == {
+        "type": "object",
+        "properties": {
+            "approved": {"type": "boolean"},
+            "verdict": {"type": "string", "enum": ["unclear", "wrong"]},
+        },
+        "required": ["approved", "verdict"],
+    }
+    assert config["outputs"] == {"approved": "result.approved", "verdict": "result.verdict"}
+    assert "task" not in _transition(pattern, "pay").extra
+    case = CaseNet(pattern)
+    data = case.initial_data()
+    marking, _ = case.settle(case.initial, data)
+    marking = case.start(marking, "check")
+    data = apply_outputs(
+        case.tasks["check"], "check", {"approved": False, "verdict": "wrong"}, data
+    )
+    marking, _ = case.settle(case.complete(marking, "check"), data)
+    assert case.startable(marking) == ["drop"]
 
 
 def test_an_xpath_path_or_function_is_left_to_rewrite() -> None:
