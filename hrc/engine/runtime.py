@@ -175,7 +175,10 @@ class CaseNet:
 
     def _processes_started_by_a_message(self) -> list[tuple[Marking, Marking]]:
         """(initial tokens, end tokens) of each process whose every first step waits for a
-        message: while it holds just its initial tokens, nothing has started it."""
+        message another process of the pattern sends (a pool of a BPMN collaboration that a
+        message flow starts): while it holds just its initial tokens, nothing has started it.
+        A process waiting for a message from outside the pattern keeps the case waiting."""
+        sent = {send.name for send in self.sends.values()}
         started = []
         for process in self.pattern.processes:
             start = process.initial_marking()
@@ -184,7 +187,11 @@ class CaseNet:
                 for transition in self.net.transitions
                 if any(place in start for place, _ in transition.pre)
             ]
-            if start and firsts and all(t.id in self.messages for t in firsts):
+            if (
+                start
+                and firsts
+                and all(t.id in self.messages and self.messages[t.id].name in sent for t in firsts)
+            ):
                 end = Counter(process.sink_places())
                 started.append((Marking(start), Marking(end)))
         return started

@@ -398,8 +398,13 @@ def _customer_and_supplier() -> CaseNet:
     for net in (customer, supplier):
         net["completion"] = "implicit"
     order = {"name": "order", "correlation": {"case": "case.id"}}
-    data = document(customer, supplier)
-    return CaseNet(read_pattern(_configured(data, xs={"message": order}, xn={"guard": "true"})))
+    data = _configured(
+        document(customer, supplier),
+        xo={"send": {"name": "order", "correlation": {"case": "=case.id"}}},
+        xs={"message": order},
+        xn={"guard": "true"},
+    )
+    return CaseNet(read_pattern(data))
 
 
 def test_a_pool_its_message_never_started_leaves_the_case_complete() -> None:
@@ -409,6 +414,16 @@ def test_a_pool_its_message_never_started_leaves_the_case_complete() -> None:
 
     assert dict(marking) == {"p2": 1, "p5": 1}
     assert net.is_final(marking)
+
+
+def test_a_process_waiting_for_a_message_from_outside_keeps_the_case_waiting() -> None:
+    net = _waiting_for_a_part()  # its first step after x0: a message no process sends
+    alone = document(process("N", "p1 xm p2 ta p3", performers={"ta": "o"}))
+    message = {"name": "part-arrived", "correlation": {"case": "case.id"}}
+    waiting = CaseNet(read_pattern(_configured(alone, xm={"message": message})))
+
+    assert not waiting.is_final(waiting.initial)
+    assert not net.is_final(net.initial)
 
 
 def test_a_pool_a_message_started_must_end_before_the_case_has() -> None:
