@@ -4,9 +4,11 @@ Camunda and Activiti write `${amount > 1000 && approved}`, Bonita and others
 plain `amount > 1000`; both read the process variables. hrc's guards read the
 same values as `data.amount`. `translate` rewrites what has a clear meaning
 (names, numbers, strings, comparisons, `&&`, `||`, `!` and JUEL's word
-operators `eq ne lt gt le ge and or not`) and returns None for anything else
-(method calls, `empty`, XPath, prose such as "Amount > 1000 €"), which the
-importer then marks as a condition to rewrite.
+operators `eq ne lt gt le ge and or not`), and of XPath, BPMN's default
+language, the same plain forms over data objects (`bpmn:getDataObject('approved')`,
+`not(...)`, `=`, `true()`); it returns None for anything else (method calls, `empty`,
+XPath paths, prose such as "Amount > 1000 €"), which the importer then marks as a
+condition to rewrite.
 """
 
 import ast
@@ -46,7 +48,10 @@ _WRAPPED = re.compile(r"^\s*[$#]\{(?P<body>.*)\}\s*$", re.DOTALL)
 
 def translate(text: str, language: str | None = None) -> str | None:
     """The guard `text` means over `data`, or None when it does not translate clearly."""
-    if (language or "").strip().lower().rsplit("/", 1)[-1] not in JUEL_LANGUAGES:
+    language = (language or "").strip().lower().rsplit("/", 1)[-1]
+    if language == "xpath" or _DATA_OBJECT.search(text):
+        text = _from_xpath(text)
+    elif language not in JUEL_LANGUAGES:
         return None
     wrapped = _WRAPPED.match(text)
     body = wrapped.group("body") if wrapped else text
@@ -57,6 +62,24 @@ def translate(text: str, language: str | None = None) -> str | None:
         return None
     guard = " ".join(words).replace("not ==", "!=")
     return guard if check(guard, ["data"]) is None else None
+
+
+# XPath, BPMN's default expression language: the spec's `bpmn:getDataObject('name')` reads a
+# data object, as a JUEL name reads a variable.
+_DATA_OBJECT = re.compile(
+    r"""bpmn:getDataObject\(\s*(?:'([A-Za-z_][A-Za-z0-9_]*)'|"([A-Za-z_][A-Za-z0-9_]*)")\s*\)"""
+)
+_XPATH_BOOLEAN = re.compile(r"\b(true|false)\(\s*\)")
+_XPATH_EQUALS = re.compile(r"(?<![!<>=])=(?!=)")
+
+
+def _from_xpath(text: str) -> str:
+    """An XPath condition in JUEL's spelling, for the few forms whose meaning is plain: data
+    objects, `true()`, `not(...)`, `=`, `and`, `or`, comparisons, literals. Anything else
+    (paths, other functions) keeps a character `_tokens` refuses."""
+    text = _DATA_OBJECT.sub(lambda match: match.group(1) or match.group(2), text)
+    text = _XPATH_BOOLEAN.sub(r"\1", text)
+    return _XPATH_EQUALS.sub("==", text)
 
 
 def _tokens(body: str) -> list[str] | None:
@@ -101,6 +124,23 @@ def data_defaults(guard: str) -> dict[str, object]:
         if key is not None:
             defaults.setdefault(key, False)
     return defaults
+
+
+def compared_values(guard: str) -> dict[str, list[object]]:
+    """Each data key the guard compares with constants, and those constants in order: the
+    answers that steer the choice (`data.clarified == 'yes'` gives clarified: ['yes'])."""
+    values: dict[str, list[object]] = {}
+    for node in ast.walk(ast.parse(guard, mode="eval")):
+        if not isinstance(node, ast.Compare):
+            continue
+        operands = [node.left, *node.comparators]
+        constants = [o.value for o in operands if isinstance(o, ast.Constant)]
+        for operand in operands:
+            key = _data_key(operand)
+            if key is not None:
+                found = values.setdefault(key, [])
+                found += [value for value in constants if value not in found]
+    return values
 
 
 def _data_key(node: ast.AST) -> str | None:

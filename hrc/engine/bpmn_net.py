@@ -135,6 +135,8 @@ class FlowNode:
     """A message a task waits for: a silent message transition in front of it."""
     loop: Json | None = None
     """A standard loop: `{"guard": ...}` or `{"rewrite": ...}` on the step back."""
+    writes: list[str] = field(default_factory=list)
+    """A task's data outputs and the data objects it writes, by name."""
     copies: tuple[int, bool] = (1, False)
     """Multi-instance: (how many, in sequence)."""
     inclusive_join: "FlowNode | None" = None
@@ -416,7 +418,7 @@ class FlowNet:
             return
         if split:
             guards = self._guards(node)
-            for flow in outgoing:
+            for flow in _unguarded_towards_the_end(outgoing, guards):
                 step = self.transition(
                     self.fresh(f"{node.hrc_id}_{flow.xml_id}"),
                     node.scope,
@@ -529,3 +531,34 @@ def _subset_guard(
 
 def _without_id(extra: Json) -> Json:
     return {key: value for key, value in extra.items() if key != "id"}
+
+
+def _unguarded_towards_the_end(flows: list[Flow], guards: dict[str, str]) -> list[Flow]:
+    """A split's flows in net order, those without a condition reordered nearest an end first.
+
+    The runtime takes the first branch whose guard holds, and a branch without one always
+    holds. BPMN leaves the choice between unconditioned flows open, but a model whose first
+    such flow goes back (a "Retry?" whose "Yes" is drawn first, a process-mining model's loop)
+    would then never end; taking the branch with the fewest steps left to an end keeps each
+    choice moving towards completion, and the loop stays for a guard to take.
+    """
+    unguarded = [flow for flow in flows if flow.xml_id not in guards]
+    ordered = iter(sorted(unguarded, key=lambda flow: _steps_to_an_end(flow.target)))
+    return [next(ordered) if flow.xml_id not in guards else flow for flow in flows]
+
+
+def _steps_to_an_end(start: FlowNode) -> float:
+    """The fewest sequence flows from `start` to a node no flow leaves (an end of its scope)."""
+    seen = {id(start)}
+    frontier, steps = [start], 0
+    while frontier:
+        if any(not node.outgoing for node in frontier):
+            return steps
+        following = []
+        for node in frontier:
+            for flow in node.outgoing:
+                if id(flow.target) not in seen:
+                    seen.add(id(flow.target))
+                    following.append(flow.target)
+        frontier, steps = following, steps + 1
+    return float("inf")

@@ -8,12 +8,13 @@ Events become the keys of their transitions (`message`, `send`, `timer`,
 `bpmn_net.FlowNet` builds the net.
 """
 
+import re
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from hrc.engine.bpmn_conditions import data_defaults, translate
+from hrc.engine.bpmn_conditions import compared_values, data_defaults, translate
 from hrc.engine.bpmn_events import (
     Reading,
     Trigger,
@@ -162,7 +163,51 @@ class ProcessReader:
                 if isinstance(guard, str):
                     for key, value in data_defaults(guard).items():
                         self.graph.data.setdefault(key, value)
+        self._answers()
         return self.graph
+
+    def _written(self, task: ET.Element) -> list[str]:
+        """The names of the task's data outputs and of the data objects it writes."""
+        objects = {
+            child.get("id"): child.get("name")
+            for child in self.element.iter()
+            if bpmn_name(child) in ("dataObject", "dataObjectReference")
+        }
+        names = [
+            output.get("name")
+            for spec in task
+            if bpmn_name(spec) == "ioSpecification"
+            for output in spec
+            if bpmn_name(output) == "dataOutput"
+        ]
+        for association in task:
+            if bpmn_name(association) == "dataOutputAssociation":
+                names += [
+                    objects.get((target.text or "").strip())
+                    for target in association
+                    if bpmn_name(target) == "targetRef"
+                ]
+        return [n for n in dict.fromkeys(names) if n and _DATA_NAME.fullmatch(n)]
+
+    def _answers(self) -> None:
+        """A task that writes data a condition reads asks for it (a form), and its answer goes
+        into the case data: in BPMN the approver's form sets `approved`, which the gateway after
+        the task reads; without it the case would keep the default and never take the other way.
+        A field the conditions compare with strings offers those strings."""
+        compared: dict[str, list[object]] = {}
+        for flow in self.graph.flows:
+            for key, values in compared_values(flow.guard or "True").items():
+                compared.setdefault(key, [])
+                compared[key] += [v for v in values if v not in compared[key]]
+        for node in self.graph.nodes:
+            asked = [key for key in node.writes if key in self.graph.data]
+            if not asked or "task" in node.extra or "task" in node.keys:
+                continue
+            fields = {key: _field(self.graph.data[key], compared.get(key, [])) for key in asked}
+            node.keys["task"] = {
+                "form": {"type": "object", "properties": fields, "required": asked},
+                "outputs": {key: f"result.{key}" for key in asked},
+            }
 
     # Containers: the process, sub-processes, called processes.
 
@@ -253,6 +298,7 @@ class ProcessReader:
         if local in TASK_KINDS:
             self.graph.tasks[node.hrc_id] = [xml_id] + ([outer] if outer else [])
             task_messages(self.reading, node, element.get("messageRef"))
+            node.writes = self._written(element)
             mark_loops(element, node)
         elif local in EVENT_KINDS and not self._event(element, node):
             self.refused.add(xml_id)
@@ -803,3 +849,16 @@ class _Callee:
 
     process: ET.Element | None = None
     pattern: Pattern | None = None
+
+
+_DATA_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _field(default: object, compared: list[object]) -> Json:
+    """The form field for a data key: of its default's type, offering the strings compared."""
+    if isinstance(default, bool) or default is None:
+        return {"type": "boolean"}
+    if isinstance(default, int | float):
+        return {"type": "number"}
+    strings = [value for value in compared if isinstance(value, str)]
+    return {"type": "string", **({"enum": strings} if strings else {})}

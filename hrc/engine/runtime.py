@@ -20,6 +20,7 @@ truth and the same rule serves the runtime, the token game and the tests.
 """
 
 import copy
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Final
@@ -159,6 +160,7 @@ class CaseNet:
             if t.kind == "silent" and t.id not in self.messages and t.id not in self.timers
         )
         self._timed = tuple(t for t in self.net.transitions if t.id in self.timers)
+        self._message_started = self._processes_started_by_a_message()
         self.space_pairs = self._space_pairs()
         self.space_tasks = frozenset(
             task for pair in self.space_pairs for task in (pair.first, pair.second)
@@ -170,6 +172,29 @@ class CaseNet:
             for task in self.tasks
             if any(place in self._needs for place, _ in self._transitions[f"complete:{task}"].pre)
         )
+
+    def _processes_started_by_a_message(self) -> list[tuple[Marking, Marking]]:
+        """(initial tokens, end tokens) of each process whose every first step waits for a
+        message another process of the pattern sends (a pool of a BPMN collaboration that a
+        message flow starts): while it holds just its initial tokens, nothing has started it.
+        A process waiting for a message from outside the pattern keeps the case waiting."""
+        sent = {send.name for send in self.sends.values()}
+        started = []
+        for process in self.pattern.processes:
+            start = process.initial_marking()
+            firsts = [
+                transition
+                for transition in self.net.transitions
+                if any(place in start for place, _ in transition.pre)
+            ]
+            if (
+                start
+                and firsts
+                and all(t.id in self.messages and self.messages[t.id].name in sent for t in firsts)
+            ):
+                end = Counter(process.sink_places())
+                started.append((Marking(start), Marking(end)))
+        return started
 
     def _space_pairs(self) -> tuple[SpacePair, ...]:
         pairs = []
@@ -208,8 +233,26 @@ class CaseNet:
 
     def is_final(self, marking: Marking) -> bool:
         """Whether the case has completed: each end place marked and nothing else, constraint
-        places aside; the end of a process that completes implicitly may hold several tokens."""
-        return self.net.is_final(marking)
+        places aside; the end of a process that completes implicitly may hold several tokens.
+        A process still waiting for the message that starts it never ran (BPMN instantiates a
+        pool at its message start event), so it counts as ended: a customer who never ordered
+        leaves the supplier's pool unstarted, and the case has completed all the same."""
+        if self.net.is_final(marking):
+            return True
+        never_ran = [
+            (start, end)
+            for start, end in self._message_started
+            if all(marking.get(place) == count for place, count in start.items())
+        ]
+        if not never_ran:
+            return False
+        tokens = dict(marking.items())
+        for start, end in never_ran:
+            for place, count in start.items():
+                tokens[place] -= count
+            for place, count in end.items():
+                tokens[place] = tokens.get(place, 0) + count
+        return self.net.is_final(Marking(tokens))
 
     # Silent transitions ------------------------------------------------------------
 

@@ -10,7 +10,7 @@ from hrc.engine.bpmn import BPMN_NAMESPACE, bpmn_to_pattern
 from hrc.engine.check import check_pattern
 from hrc.engine.document import FormatError, read_pattern
 from hrc.engine.model import Pattern
-from hrc.engine.runtime import CaseNet
+from hrc.engine.runtime import CaseNet, apply_outputs
 from tests.engine.builders import document, process
 from tests.engine.test_bpmn import _arcs, bpmn, flows, refused
 
@@ -85,6 +85,103 @@ def test_a_juel_condition_becomes_a_guard_that_routes_the_case() -> None:
     )
     assert _run(pattern, {"amount": 5000, "blocked": False}) == ["big"]
     assert _run(pattern, {"amount": 5, "blocked": False}) == ["small"]
+
+
+def test_an_xpath_condition_over_data_objects_becomes_a_guard_that_routes_the_case() -> None:
+    xpath = 'language="http://www.w3.org/1999/XPath"'
+    text = bpmn(
+        '<startEvent id="s"/><exclusiveGateway id="x"/><task id="pay"/><task id="review"/>'
+        '<exclusiveGateway id="m"/><endEvent id="e"/>'
+        '<sequenceFlow id="yes" sourceRef="x" targetRef="pay">'
+        "<conditionExpression>bpmn:getDataObject('approved')</conditionExpression></sequenceFlow>"
+        '<sequenceFlow id="no" sourceRef="x" targetRef="review">'
+        f"<conditionExpression {xpath}>not(bpmn:getDataObject('approved')) and "
+        "bpmn:getDataObject('state') = 'open'</conditionExpression></sequenceFlow>"
+        '<sequenceFlow id="f2" sourceRef="pay" targetRef="m">'
+        f"<conditionExpression {xpath}>true()</conditionExpression></sequenceFlow>"
+        + flows("f1: s -> x", "f3: review -> m", "f4: m -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    assert _transition(pattern, "x_yes").extra["guard"] == "data.approved"
+    assert _transition(pattern, "x_no").extra["guard"] == (
+        "not ( data.approved ) and data.state == 'open'"
+    )
+    assert _run(pattern, {"approved": True, "state": "open"}) == ["pay"]
+    assert _run(pattern, {"approved": False, "state": "open"}) == ["review"]
+
+
+def test_a_task_that_writes_the_data_a_condition_reads_asks_for_it_in_its_form() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><userTask id="check" name="Check">'
+        '<ioSpecification><dataOutput id="o1" name="approved"/></ioSpecification>'
+        "<dataOutputAssociation><targetRef>ref</targetRef></dataOutputAssociation></userTask>"
+        '<dataObject id="obj" name="verdict"/><dataObjectReference id="ref" dataObjectRef="obj"'
+        ' name="verdict"/>'
+        '<exclusiveGateway id="x"/><task id="pay"/><task id="ask"/><task id="drop"/>'
+        '<exclusiveGateway id="m"/><endEvent id="e"/>'
+        '<sequenceFlow id="yes" sourceRef="x" targetRef="pay"><conditionExpression>'
+        "${approved}</conditionExpression></sequenceFlow>"
+        '<sequenceFlow id="more" sourceRef="x" targetRef="ask"><conditionExpression>'
+        "${!approved &amp;&amp; verdict == 'unclear'}</conditionExpression></sequenceFlow>"
+        '<sequenceFlow id="no" sourceRef="x" targetRef="drop"><conditionExpression>'
+        "${!approved &amp;&amp; verdict == 'wrong'}</conditionExpression></sequenceFlow>"
+        + flows("f1: s -> check", "f2: check -> x", "f3: pay -> m", "f4: ask -> m")
+        + flows("f5: drop -> m", "f6: m -> e")
+    )
+    pattern = bpmn_to_pattern(text)
+    config = _transition(pattern, "check").extra["task"]
+
+    assert config["form"] == {
+        "type": "object",
+        "properties": {
+            "approved": {"type": "boolean"},
+            "verdict": {"type": "string", "enum": ["unclear", "wrong"]},
+        },
+        "required": ["approved", "verdict"],
+    }
+    assert config["outputs"] == {"approved": "result.approved", "verdict": "result.verdict"}
+    assert "task" not in _transition(pattern, "pay").extra
+    case = CaseNet(pattern)
+    data = case.initial_data()
+    marking, _ = case.settle(case.initial, data)
+    marking = case.start(marking, "check")
+    data = apply_outputs(
+        case.tasks["check"], "check", {"approved": False, "verdict": "wrong"}, data
+    )
+    marking, _ = case.settle(case.complete(marking, "check"), data)
+    assert case.startable(marking) == ["drop"]
+
+
+def test_an_xpath_path_or_function_is_left_to_rewrite() -> None:
+    text = bpmn(
+        '<startEvent id="s"/><exclusiveGateway id="x"/><task id="b"/><endEvent id="e"/>'
+        '<sequenceFlow id="f2" sourceRef="x" targetRef="b"><conditionExpression '
+        'language="http://www.w3.org/1999/XPath">count(/order/item) &gt; 3</conditionExpression>'
+        "</sequenceFlow>" + flows("f1: s -> x", "f3: b -> e")
+    )
+    step = _transition(bpmn_to_pattern(text), "x_f2")
+    assert "guard" not in step.extra
+    assert "count(/order/item)" in step.extra["rewrite"]
+
+
+def test_a_choice_without_conditions_takes_the_branch_nearest_an_end_first() -> None:
+    # "Retry?" drawn with its way back first: taken first in net order, the case never ended.
+    text = bpmn(
+        '<startEvent id="s"/><exclusiveGateway id="m"/><task id="pay" name="Pay"/>'
+        '<exclusiveGateway id="retry" name="Retry?"/><task id="give_up" name="Give up"/>'
+        '<endEvent id="e"/>'
+        + flows(
+            "f1: s -> m",
+            "f2: m -> pay",
+            "f3: pay -> retry",
+            "again: retry -> m",
+            "stop: retry -> give_up",
+            "f4: give_up -> e",
+        )
+    )
+    pattern = bpmn_to_pattern(text)
+    assert _run(pattern, {}) == ["pay", "give_up"]
+    assert check_pattern(pattern).sound is True  # the way back is still there
 
 
 def test_an_empty_condition_is_none_and_prose_is_left_to_rewrite() -> None:

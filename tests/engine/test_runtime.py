@@ -390,6 +390,52 @@ def test_no_message_is_awaited_before_the_case_reaches_it() -> None:
         net.receive(net.initial, "xm")
 
 
+def _customer_and_supplier() -> CaseNet:
+    """A customer who may order (xo sends "order") or not (xn), and a supplier's pool that
+    the order starts (xs waits for it)."""
+    customer = process("C", "p0 tc p1 xo p2", "p1 xn p2", performers={"tc": "o"})
+    supplier = process("S", "p5 xs p6 ts p7", performers={"ts": "s"})
+    for net in (customer, supplier):
+        net["completion"] = "implicit"
+    order = {"name": "order", "correlation": {"case": "case.id"}}
+    data = _configured(
+        document(customer, supplier),
+        xo={"send": {"name": "order", "correlation": {"case": "=case.id"}}},
+        xs={"message": order},
+        xn={"guard": "true"},
+    )
+    return CaseNet(read_pattern(data))
+
+
+def test_a_pool_its_message_never_started_leaves_the_case_complete() -> None:
+    net = _customer_and_supplier()
+    marking = net.complete(net.start(net.initial, "tc"), "tc")
+    marking = net.transition("xn").fire(marking)  # the customer orders nothing
+
+    assert dict(marking) == {"p2": 1, "p5": 1}
+    assert net.is_final(marking)
+
+
+def test_a_process_waiting_for_a_message_from_outside_keeps_the_case_waiting() -> None:
+    net = _waiting_for_a_part()  # its first step after x0: a message no process sends
+    alone = document(process("N", "p1 xm p2 ta p3", performers={"ta": "o"}))
+    message = {"name": "part-arrived", "correlation": {"case": "case.id"}}
+    waiting = CaseNet(read_pattern(_configured(alone, xm={"message": message})))
+
+    assert not waiting.is_final(waiting.initial)
+    assert not net.is_final(net.initial)
+
+
+def test_a_pool_a_message_started_must_end_before_the_case_has() -> None:
+    net = _customer_and_supplier()
+    marking = net.complete(net.start(net.initial, "tc"), "tc")
+    marking = net.receive(net.transition("xo").fire(marking), "xs")
+
+    assert not net.is_final(marking)
+    assert net.is_final(net.complete(net.start(marking, "ts"), "ts"))
+    assert not net.is_final(net.initial)  # the customer's own start is not a message's
+
+
 @pytest.mark.parametrize("transition", ["x0", "start:ta", "ta"])
 def test_receive_fires_only_message_transitions(transition: str) -> None:
     net = _waiting_for_a_part()
