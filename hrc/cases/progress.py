@@ -326,10 +326,14 @@ def _cancel(case: Case, item: WorkItem, by: str) -> None:
     a cobot). What it kept out of a shared area goes on, as when it completes; a cobot it paused
     or slowed stays so until a person says the area is clear (confirm_left_area)."""
     _close(case, item, WorkItemState.CANCELLED)
-    record_event(case, EventType.TASK_CANCELLED, item=item, detail={"by": by})
     # The model, not the operator, ended the task: the operator may still be in the area. A
     # pause of its own cobot stays until the task beside it ends: that step is not over.
     _end_interruptions(case, Q(by_work_item=item) & ~Q(mode__in=COMMANDED_MODES))
+    presence = Q(by_work_item=item, mode__in=COMMANDED_MODES, ended_at__isnull=True)
+    detail: dict[str, Any] = {"by": by}
+    if item.kind == WorkItemKind.OPERATOR and Interruption.objects.filter(presence).exists():
+        detail["in_area"] = True  # the tablet asks its operator to say when they have left
+    record_event(case, EventType.TASK_CANCELLED, item=item, detail=detail)
 
 
 def end_presence(case: Case, item: WorkItem) -> bool:

@@ -213,9 +213,11 @@ def test_a_message_transition_cancels_the_running_task_it_interrupts(
 
 @pytest.fixture
 def beside_cobot(
-    organisation: Organisation, engineer: User, operator: User, cobot: Cobot
-) -> tuple[Case, WorkItem]:
-    """The inspection cancelled by its deadline while it paused the cobot's pick."""
+    organisation: Organisation, engineer: User, operator: User, cobot: Cobot,
+    deltas: list[dict[str, Any]],
+) -> tuple[Case, WorkItem]:  # fmt: skip
+    """The inspection cancelled by its deadline while it paused the cobot's pick (the deltas
+    published from the start)."""
     case = _start(
         organisation, engineer, patterns.inspection_beside_cobot_with_deadline(),
         {"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
@@ -231,15 +233,32 @@ def beside_cobot(
     return case, inspect
 
 
+def _in_area(operator: User, organisation: Organisation) -> list[tuple[int, str]]:
+    """The tablet's items that hold the area, from a fresh snapshot."""
+    access = access_of(operator, organisation.pk)
+    assert access is not None
+    items = snapshot(access, "")["work_items"]
+    return [(item["id"], item["state"]) for item in items if item["in_area"]]
+
+
 def test_the_cobot_paused_for_a_cancelled_operator_stays_paused_until_the_operator_has_left(
-    beside_cobot: tuple[Case, WorkItem], operator: User
-) -> None:
+    beside_cobot: tuple[Case, WorkItem], operator: User, organisation: Organisation,
+    deltas: list[dict[str, Any]],
+) -> None:  # fmt: skip
     case, inspect = beside_cobot
     pause = Interruption.objects.get(case=case, by_work_item=inspect)
     assert pause.ended_at is None  # the cancellation alone resumes nothing
     assert not _events(case, EventType.TASK_RESUMED)
+    # The operator's tablet keeps the task, asking them to say when they are out.
+    assert _in_area(operator, organisation) == [(inspect.pk, "cancelled")]
+    [cancelled] = [d for d in deltas if d["event"] == EventType.TASK_CANCELLED]
+    assert cancelled["item"]["in_area"] is True
 
     assert services.confirm_left_area(inspect, by=operator)
+
+    assert _in_area(operator, organisation) == []
+    assert deltas[-1]["event"] == EventType.AREA_LEFT
+    assert deltas[-1]["item"]["in_area"] is False
 
     pause.refresh_from_db()
     assert pause.ended_at is not None
