@@ -303,3 +303,22 @@ def test_the_area_is_cleared_only_for_a_cancelled_task(
     services.start_work_item(inspect, user=operator)
     with pytest.raises(Conflict, match="was not cancelled"):
         services.confirm_left_area(inspect, by=operator)
+
+
+def test_a_supervisor_says_so_on_the_case_page(
+    beside_cobot: tuple[Case, WorkItem], engineer: User, operator: User
+) -> None:
+    case, inspect = beside_cobot
+    page = reverse("cases:case-detail", args=[case.pk])
+    control = reverse("cases:case-control", args=[case.pk])
+    client = Client()
+    client.force_login(operator)  # no supervisor: refused, as every control of the case
+    assert client.post(control, {"action": "left-area", "item": inspect.pk}).status_code == 403
+    client.force_login(engineer)
+    assert "The operator has left the area" in client.get(page).content.decode()
+
+    answer = client.post(control, {"action": "left-area", "item": inspect.pk})
+
+    assert answer.status_code == 302
+    assert Interruption.objects.get(by_work_item=inspect).ended_at is not None
+    assert "The operator has left the area" not in client.get(page).content.decode()
