@@ -112,6 +112,9 @@ class EventType(models.TextChoices):
     CANCELLED_STEP_ENDED = "cancelled-step-ended", "Cancelled task's step ended"
     TASK_INTERRUPTED = "task-interrupted", "Task interrupted"
     TASK_RESUMED = "task-resumed", "Task resumed"
+    # A person said the operator of a cancelled task has left its shared area: what the
+    # operator's presence paused or slowed resumes (the cancellation alone does not).
+    AREA_LEFT = "area-left", "Operator left the area"
     # Refused (an operator) or held back (a cobot's step) while another task is in its shared area.
     TASK_KEPT_OUT = "task-kept-out", "Task kept out of a shared area"
     # A silent (routing) transition fired.

@@ -321,14 +321,29 @@ def _inputs(net: CaseNet, task: str) -> set[str]:
 
 
 def _cancel(case: Case, item: WorkItem, by: str) -> None:
-    """Ends a running item the transition `by` cancelled; the shared-area interruptions it
-    caused end as if it had completed. An operator's leaves the tablets; a cobot's step not
-    yet sent leaves the queue, one on the cobot is not stopped (a person stops a cobot)."""
+    """Ends a running item the transition `by` cancelled. An operator's leaves the tablets; a
+    cobot's step not yet sent leaves the queue, one on the cobot is not stopped (a person stops
+    a cobot). What it kept out of a shared area goes on, as when it completes; a cobot it paused
+    or slowed stays so until a person says the area is clear (confirm_left_area)."""
     _close(case, item, WorkItemState.CANCELLED)
-    record_event(case, EventType.TASK_CANCELLED, item=item, detail={"by": by})
-    # What it kept out of or paused in a shared area goes on, as when it completes. A pause
-    # of its own cobot stays until the task beside it ends: that step is not over.
-    _end_interruptions(case, Q(by_work_item=item))
+    # The model, not the operator, ended the task: the operator may still be in the area. A
+    # pause of its own cobot stays until the task beside it ends: that step is not over.
+    _end_interruptions(case, Q(by_work_item=item) & ~Q(mode__in=COMMANDED_MODES))
+    presence = Q(by_work_item=item, mode__in=COMMANDED_MODES, ended_at__isnull=True)
+    detail: dict[str, Any] = {"by": by}
+    if item.kind == WorkItemKind.OPERATOR and Interruption.objects.filter(presence).exists():
+        detail["in_area"] = True  # the tablet asks its operator to say when they have left
+    record_event(case, EventType.TASK_CANCELLED, item=item, detail=detail)
+
+
+def end_presence(case: Case, item: WorkItem) -> bool:
+    """Ends the pauses and slowdowns a cancelled item's operator caused, once a person says
+    the operator has left the area; whether any was still open. Call holding the case row lock."""
+    which = Q(by_work_item=item, mode__in=COMMANDED_MODES)
+    if not Interruption.objects.filter(which, case=case, ended_at__isnull=True).exists():
+        return False
+    _end_interruptions(case, which)
+    return True
 
 
 def start_task(case: Case, net: CaseNet, item: WorkItem, user: User | None) -> None:

@@ -290,6 +290,23 @@ def complete_work_item(
     return item
 
 
+def confirm_left_area(item: WorkItem, *, by: User) -> bool:
+    """Records that the operator of a cancelled task has left the shared area (said by that
+    operator on the tablet, or by a supervisor): the cobots its presence paused or slowed resume.
+    Whether anything was still held: a second confirmation changes nothing. Conflict unless the
+    task was cancelled. The caller has checked that `by` may say so for this item."""
+    with transaction.atomic():
+        case = progress.lock_case(item.case_id)
+        item = WorkItem.objects.get(pk=item.pk)
+        if item.state != WorkItemState.CANCELLED:
+            raise Conflict(f"{item.label} was not cancelled: the area is cleared when it ends.")
+        if not progress.end_presence(case, item):
+            return False
+        record_event(case, EventType.AREA_LEFT, item=item, user=by)
+        case.save()
+    return True
+
+
 def resolve_incident(
     incident: Incident,
     *,

@@ -31,6 +31,7 @@ from django.views.decorators.http import require_POST
 
 from hrc.cases import selectors, services
 from hrc.cases.choices import (
+    COMMANDED_MODES,
     OPEN_CASE_STATUSES,
     OPEN_WORK_ITEM_STATES,
     CaseStatus,
@@ -141,6 +142,17 @@ class InterruptionRow:
     @property
     def duration(self) -> str:
         return format_duration(self.seconds)
+
+    @property
+    def awaits_leaving(self) -> bool:
+        """A cobot paused or slowed for an operator whose task was cancelled: it waits for
+        someone to say the operator has left the area (services.confirm_left_area)."""
+        held = self.interruption
+        return (
+            self.ongoing
+            and held.mode in COMMANDED_MODES
+            and held.by_work_item.state == WorkItemState.CANCELLED
+        )
 
 
 @login_required
@@ -520,9 +532,17 @@ def case_start(request: HttpRequest) -> HttpResponse:
 @login_required
 @require_POST
 def case_control(request: HttpRequest, pk: int) -> HttpResponse:
-    """Cancels (`action=cancel`, with `confirm`), suspends or resumes the case, then shows it."""
+    """Cancels (`action=cancel`, with `confirm`), suspends or resumes the case, or says the
+    operator of its cancelled task `item` has left the area (`action=left-area`), then shows it."""
     case = _supervised_case(request, pk)
     action = request.POST.get("action", "")
+    if action == "left-area":
+        wanted = _whole(request.POST.get("item", ""), "item")
+        item = WorkItem.objects.filter(case=case, pk=wanted).first()
+        if item is None:
+            raise Invalid(f"Case {case.pk} has no work item {wanted}.")
+        services.confirm_left_area(item, by=_user(request))
+        return redirect("cases:case-detail", case.pk)
     steer = CASE_ACTIONS.get(action)
     if steer is None:
         raise Invalid(f"action must be one of {', '.join(CASE_ACTIONS)}, not {action!r}.")

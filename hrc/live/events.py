@@ -50,6 +50,9 @@ class WorkItemData(TypedDict):
     claimed_by: int | None
     offered_at: str
     started_at: str | None
+    # A cancelled operator task whose operator may still be in its shared area: a cobot stays
+    # paused or slowed until they (or a supervisor) say they have left (POST .../left-area/).
+    in_area: bool
 
 
 class IncidentData(TypedDict):

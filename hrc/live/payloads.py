@@ -61,6 +61,7 @@ class WorkItemRow(TypedDict):
     claimed_by_id: int | None
     offered_at: dt.datetime
     started_at: dt.datetime | None
+    in_area: bool  # annotated by the snapshot's query (selectors._work_items)
 
 
 class IncidentRow(TypedDict):
@@ -108,7 +109,9 @@ def _case_name(case: Case) -> str:
     return str((case.version.document or {}).get("name") or "")
 
 
-def work_item_row(item: WorkItem, *, started_by: User | None = None) -> WorkItemRow:
+def work_item_row(
+    item: WorkItem, *, started_by: User | None = None, in_area: bool = False
+) -> WorkItemRow:
     claimed_by = item.claimed_by_id
     if claimed_by is None and started_by is not None and item.kind == "operator":
         claimed_by = started_by.pk  # starting claims it; the service sets it after the event
@@ -126,6 +129,7 @@ def work_item_row(item: WorkItem, *, started_by: User | None = None) -> WorkItem
         "claimed_by_id": claimed_by,
         "offered_at": item.offered_at,
         "started_at": item.started_at,
+        "in_area": in_area,
     }
 
 
@@ -172,6 +176,7 @@ def work_item_data(row: WorkItemRow, mapping: Mapping[str, Any] | None) -> WorkI
         "claimed_by": row["claimed_by_id"],
         "offered_at": row["offered_at"].isoformat(),
         "started_at": row["started_at"].isoformat() if row["started_at"] else None,
+        "in_area": row["in_area"],
     }
 
 
@@ -262,7 +267,10 @@ def case_delta(
                 "incident": incident}  # fmt: skip
     if item is not None:
         started_by = user if event == "task-started" else None
-        data = work_item_data(work_item_row(item, started_by=started_by), case.actor_mapping)
+        # Only its cancellation says a task holds the area; what it does next (area-left) ends it.
+        in_area = event == "task-cancelled" and bool((detail or {}).get("in_area"))
+        row = work_item_row(item, started_by=started_by, in_area=in_area)
+        data = work_item_data(row, case.actor_mapping)
         return {"type": "work-item", "case": case.pk, "seq": seq, "event": event, "item": data}
     return {"type": "case", "case": case.pk, "seq": seq, "event": event,
             "data": case_data(case_row(case))}  # fmt: skip

@@ -10,11 +10,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from django.db.models import F
+from django.db.models import BooleanField, Exists, ExpressionWrapper, F, OuterRef, Q
 from django.db.models.fields.json import KeyTextTransform
 
-from hrc.cases.choices import OPEN_CASE_STATUSES, OPEN_WORK_ITEM_STATES, JobState
-from hrc.cases.models import Case, Incident, Job, WorkItem
+from hrc.cases.choices import (
+    COMMANDED_MODES,
+    OPEN_CASE_STATUSES,
+    OPEN_WORK_ITEM_STATES,
+    JobState,
+    WorkItemState,
+)
+from hrc.cases.models import Case, Incident, Interruption, Job, WorkItem
 from hrc.cobots.models import CellStop, Cobot
 from hrc.live import cobot_states, payloads
 from hrc.live.events import (
@@ -143,8 +149,15 @@ def _open_cases(organisation: int) -> tuple[list[CaseData], dict[int, Any]]:
 
 
 def _open_work_items(case_ids: list[int], mappings: dict[int, Any]) -> list[WorkItemData]:
+    """The open items, and the cancelled ones whose operator may still be in the area."""
+    holding = Interruption.objects.filter(
+        by_work_item=OuterRef("pk"), mode__in=sorted(COMMANDED_MODES), ended_at__isnull=True
+    )
+    in_area = Q(state=WorkItemState.CANCELLED) & Exists(holding)
     rows = (
-        WorkItem.objects.filter(case_id__in=case_ids, state__in=sorted(OPEN_WORK_ITEM_STATES))
+        WorkItem.objects.filter(case_id__in=case_ids)
+        .annotate(in_area=ExpressionWrapper(in_area, output_field=BooleanField()))
+        .filter(Q(state__in=sorted(OPEN_WORK_ITEM_STATES)) | Q(in_area=True))
         .order_by("offered_at", "id")
         .values(*WORK_ITEM_FIELDS)
     )

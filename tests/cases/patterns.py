@@ -197,6 +197,29 @@ def terminate_on_alarm() -> dict[str, Any]:
     return _operators_only("Terminate on alarm", _process(tasks, arcs, places))
 
 
+def inspection_beside_cobot_with_deadline(timer: str = "PT5M") -> dict[str, Any]:
+    """The cobot picks (tc1) while an operator inspects (to2) in the shared area, which pauses
+    the pick; `late` (a timer) cancels the inspection, perhaps with the operator still there."""
+    tasks: list[dict[str, Any]] = [
+        {"id": "split"},
+        {"id": "tc1", "performer": "c", "label": "pick", "task": {
+            "step": {"number": PICK}, "timeout": 30}},
+        {"id": "to2", "performer": "o", "label": "inspect"},
+        {"id": "in_time"},
+        {"id": "late", "label": "inspection late", "timer": timer, "cancels": ["to2", "p3", "p5"]},
+        {"id": "join"},
+    ]  # fmt: skip
+    arcs = [
+        ["p0", "split"], ["split", "p2"], ["split", "p3"], ["split", "w"],
+        ["p2", "tc1"], ["tc1", "p4"], ["p3", "to2"], ["to2", "p5"],
+        ["p5", "in_time"], ["w", "in_time"], ["in_time", "p6"], ["w", "late"], ["late", "p6"],
+        ["p4", "join"], ["p6", "join"], ["join", "p_end"],
+    ]  # fmt: skip
+    places = ["p0", "p2", "p3", "p4", "p5", "p6", "w", "p_end"]
+    constraint = {"from": "to2", "to": "tc1", "type": "space", "interrupt": "pause"}
+    return _document("Inspection beside the cobot", _process(tasks, arcs, places), [constraint])
+
+
 def _operators_only(name: str, process: dict[str, Any]) -> dict[str, Any]:
     document = _document(name, {**process, "actors": ["o"]}, [])
     document["actors"] = [{"id": "o", "type": "operator"}]

@@ -9,16 +9,18 @@ import pytest
 from django.contrib.auth.models import User
 from django.test import Client
 from django.urls import reverse
+from rest_framework.test import APIClient
 
 from hrc.cases import jobs, services, timers
-from hrc.cases.choices import CaseStatus, EventType, JobState, WorkItemState
+from hrc.cases.choices import CaseStatus, EventType, InterruptionMode, JobState, WorkItemState
 from hrc.cases.messages import receive_message
-from hrc.cases.models import Case, CaseEvent, CaseTimer, Incident, Job, WorkItem
+from hrc.cases.models import Case, CaseEvent, CaseTimer, Incident, Interruption, Job, WorkItem
 from hrc.cobots.drivers.base import CommandRefused
 from hrc.cobots.models import Cobot
 from hrc.errors import Conflict
 from hrc.live import groups
 from hrc.live.selectors import access_of, snapshot
+from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases import patterns
@@ -204,3 +206,119 @@ def test_a_message_transition_cancels_the_running_task_it_interrupts(
         (EventType.TASK_CANCELLED, "to1", {"by": "late"})
     ]
     assert factories.open_work_item(case, "to_rework")
+
+
+# A cancelled operator's presence: the cobot it paused waits for a person ------------------
+
+
+@pytest.fixture
+def beside_cobot(
+    organisation: Organisation, engineer: User, operator: User, cobot: Cobot,
+    deltas: list[dict[str, Any]],
+) -> tuple[Case, WorkItem]:  # fmt: skip
+    """The inspection cancelled by its deadline while it paused the cobot's pick (the deltas
+    published from the start)."""
+    case = _start(
+        organisation, engineer, patterns.inspection_beside_cobot_with_deadline(),
+        {"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+    )  # fmt: skip
+    assert jobs.lease_next_job(cobot.pk) is not None  # the pick runs on the cobot
+    inspect = factories.open_work_item(case, "to2")
+    services.start_work_item(inspect, user=operator)
+    [pause] = Interruption.objects.filter(case=case, by_work_item=inspect)
+    assert (pause.mode, pause.ended_at) == (InterruptionMode.PAUSE, None)
+    _ring(case)
+    inspect.refresh_from_db()
+    assert inspect.state == WorkItemState.CANCELLED
+    return case, inspect
+
+
+def _in_area(operator: User, organisation: Organisation) -> list[tuple[int, str]]:
+    """The tablet's items that hold the area, from a fresh snapshot."""
+    access = access_of(operator, organisation.pk)
+    assert access is not None
+    items = snapshot(access, "")["work_items"]
+    return [(item["id"], item["state"]) for item in items if item["in_area"]]
+
+
+def test_the_cobot_paused_for_a_cancelled_operator_stays_paused_until_the_operator_has_left(
+    beside_cobot: tuple[Case, WorkItem], operator: User, organisation: Organisation,
+    deltas: list[dict[str, Any]],
+) -> None:  # fmt: skip
+    case, inspect = beside_cobot
+    pause = Interruption.objects.get(case=case, by_work_item=inspect)
+    assert pause.ended_at is None  # the cancellation alone resumes nothing
+    assert not _events(case, EventType.TASK_RESUMED)
+    # The operator's tablet keeps the task, asking them to say when they are out.
+    assert _in_area(operator, organisation) == [(inspect.pk, "cancelled")]
+    [cancelled] = [d for d in deltas if d["event"] == EventType.TASK_CANCELLED]
+    assert cancelled["item"]["in_area"] is True
+
+    assert services.confirm_left_area(inspect, by=operator)
+
+    assert _in_area(operator, organisation) == []
+    assert deltas[-1]["event"] == EventType.AREA_LEFT
+    assert deltas[-1]["item"]["in_area"] is False
+
+    pause.refresh_from_db()
+    assert pause.ended_at is not None
+    assert [t for t, *_ in _events(case, EventType.TASK_RESUMED, EventType.AREA_LEFT)] == [
+        EventType.TASK_RESUMED, EventType.AREA_LEFT,
+    ]  # fmt: skip
+    ended = pause.ended_at
+    assert not services.confirm_left_area(inspect, by=operator)  # a second one does nothing
+    pause.refresh_from_db()
+    assert pause.ended_at == ended
+    assert len(_events(case, EventType.AREA_LEFT)) == 1
+
+
+def test_only_its_operator_or_a_supervisor_says_the_area_is_clear(
+    beside_cobot: tuple[Case, WorkItem], organisation: Organisation, engineer: User,
+    outsider: User,
+) -> None:  # fmt: skip
+    _, inspect = beside_cobot
+    url = f"/api/work-items/{inspect.pk}/left-area/"
+    other = factories.make_member(organisation, Role.OPERATOR, "oscar-operator")
+    for user, status in [(outsider, 404), (other, 403)]:
+        client = APIClient()
+        client.force_authenticate(user)
+        assert client.post(url).status_code == status
+    assert Interruption.objects.get(by_work_item=inspect).ended_at is None
+    client = APIClient()
+    client.force_authenticate(engineer)
+    answer = client.post(url)
+    assert answer.status_code == 200, answer.content
+    assert answer.json()["state"] == "cancelled"
+    assert Interruption.objects.get(by_work_item=inspect).ended_at is not None
+
+
+def test_the_area_is_cleared_only_for_a_cancelled_task(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    case = _start(
+        organisation, engineer, patterns.inspection_with_deadline(),
+        {"o": {"users": [operator.pk]}},
+    )  # fmt: skip
+    inspect = factories.open_work_item(case, "to1")
+    services.start_work_item(inspect, user=operator)
+    with pytest.raises(Conflict, match="was not cancelled"):
+        services.confirm_left_area(inspect, by=operator)
+
+
+def test_a_supervisor_says_so_on_the_case_page(
+    beside_cobot: tuple[Case, WorkItem], engineer: User, operator: User
+) -> None:
+    case, inspect = beside_cobot
+    page = reverse("cases:case-detail", args=[case.pk])
+    control = reverse("cases:case-control", args=[case.pk])
+    client = Client()
+    client.force_login(operator)  # no supervisor: refused, as every control of the case
+    assert client.post(control, {"action": "left-area", "item": inspect.pk}).status_code == 403
+    client.force_login(engineer)
+    assert "The operator has left the area" in client.get(page).content.decode()
+
+    answer = client.post(control, {"action": "left-area", "item": inspect.pk})
+
+    assert answer.status_code == 302
+    assert Interruption.objects.get(by_work_item=inspect).ended_at is not None
+    assert "The operator has left the area" not in client.get(page).content.decode()

@@ -25,6 +25,8 @@ export interface WorkItemData {
   claimed_by: number | null;
   offered_at: string;
   started_at: string | null;
+  // A cancelled operator task whose operator may still be in its shared area (a cobot waits).
+  in_area: boolean;
 }
 
 export interface IncidentData {

@@ -151,7 +151,8 @@ export class LiveStore {
     if (current) current.seq = delta.seq;
     else if (this.ended.has(delta.case)) this.ended.set(delta.case, delta.seq);
     if (delta.type === "work-item") {
-      if (OPEN_WORK_ITEM_STATES.has(delta.item.state)) state.workItems.set(delta.item.id, delta.item);
+      const shown = OPEN_WORK_ITEM_STATES.has(delta.item.state) || delta.item.in_area;
+      if (shown) state.workItems.set(delta.item.id, delta.item);
       else state.workItems.delete(delta.item.id);
     } else if (delta.incident.resolution === "") {
       state.incidents.set(delta.incident.id, delta.incident);

@@ -35,6 +35,7 @@ export const EVENT_TYPES: Record<string, string> = {
   "cancelled-step-ended": "Cancelled task's step ended",
   "task-interrupted": "Task interrupted",
   "task-resumed": "Task resumed",
+  "area-left": "Operator left the area",
   "task-kept-out": "Task kept out of a shared area",
   "transition-fired": "Transition fired",
   "message-sent": "Message sent",

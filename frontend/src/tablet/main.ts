@@ -108,6 +108,10 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     const where = cellWords(cellsOf(state, [item]));
     article.append(element("p", "away", `At ${where}: go there to do it.`));
   }
+  if (item.in_area) {
+    // The process, not the operator, ended it: the cobot it held waits for them to be out.
+    article.append(element("p", "in-area", "Cancelled. A cobot stays paused until you have left the shared area."));
+  }
   if (item.instructions) article.append(element("p", "instructions", item.instructions));
   const work = cobotWork(state, item);
   if (work.length) {
@@ -117,7 +121,7 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
   }
   const actions = element("div", "card-actions");
   const action = nextAction(state, item);
-  if (action) actions.append(actionButton(item, action, `action ${action === "complete" ? "primary" : ""}`));
+  if (action) actions.append(actionButton(item, action, `action ${action === "complete" || action === "left-area" ? "primary" : ""}`));
   if (mayGiveBack(state, item)) actions.append(actionButton(item, "unclaim", "give-back"));
   if (actions.childElementCount) article.append(actions);
   return article;
@@ -132,7 +136,14 @@ function actionButton(item: WorkItemData, action: string, className: string): HT
 }
 
 function label(action: string): string {
-  return { claim: "Claim", start: "Start", complete: "Complete…", unclaim: "Give back" }[action] ?? action;
+  const labels: Record<string, string> = {
+    claim: "Claim",
+    start: "Start",
+    complete: "Complete…",
+    unclaim: "Give back",
+    "left-area": "I have left the area",
+  };
+  return labels[action] ?? action;
 }
 
 function renderCobots(state: LiveState): void {

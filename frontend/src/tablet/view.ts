@@ -128,9 +128,14 @@ export function humanSafety(mode: string): string {
   return mode.replace(/^SAFETY_MODE_/, "").replace(/_/g, " ").toLowerCase();
 }
 
-/** What the task's button does next: claim, start, complete; null when nothing. */
-export function nextAction(state: LiveState, item: WorkItemData): "claim" | "start" | "complete" | null {
+/** What the task's button does next: claim, start, complete, or (a cancelled task whose
+ * operator may still be in the shared area) say they have left; null when nothing. */
+export function nextAction(
+  state: LiveState,
+  item: WorkItemData,
+): "claim" | "start" | "complete" | "left-area" | null {
   const me = state.user.id;
+  if (item.state === "cancelled") return item.in_area && item.claimed_by === me ? "left-area" : null;
   if (item.state === "running") return item.claimed_by === me ? "complete" : null;
   if (item.state === "claimed") return item.claimed_by === me ? "start" : null;
   if (item.state === "offered") return item.candidates.includes(me) ? "start" : "claim";

@@ -41,6 +41,7 @@ export function item(overrides: Partial<WorkItemData> = {}): WorkItemData {
     claimed_by: null,
     offered_at: "2026-01-01T00:00:00+00:00",
     started_at: null,
+    in_area: false,
     ...overrides,
   };
 }

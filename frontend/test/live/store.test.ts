@@ -39,6 +39,15 @@ describe("applying deltas", () => {
     expect(store.hasHoles()).toBe(false);
   });
 
+  it("keeps a cancelled task while its operator may be in the area, until they have left", () => {
+    const store = loaded();
+    store.apply(itemDelta(3, { state: "running", claimed_by: 7 }, "task-started"));
+    store.apply(itemDelta(4, { state: "cancelled", claimed_by: 7, in_area: true }, "task-cancelled"));
+    expect(store.state!.workItems.get(100)!.in_area).toBe(true);
+    store.apply(itemDelta(5, { state: "cancelled", claimed_by: 7 }, "area-left"));
+    expect(store.state!.workItems.has(100)).toBe(false);
+  });
+
   it("starts a new case at seq 1", () => {
     const store = loaded();
     expect(store.apply(caseDelta(11, 1, "running", "case-started"))).toBe("applied");

@@ -1,7 +1,17 @@
 import { describe, expect, it } from "vitest";
 import type { Snapshot } from "../../src/live/events";
 import { type LiveState, LiveStore } from "../../src/live/store";
-import { atThisCell, cellsOf, cellWords, cobotWork, elsewhere, myTasks, teamTasks, withDisplayMessages } from "../../src/tablet/view";
+import {
+  atThisCell,
+  cellsOf,
+  cellWords,
+  cobotWork,
+  elsewhere,
+  myTasks,
+  nextAction,
+  teamTasks,
+  withDisplayMessages,
+} from "../../src/tablet/view";
 import { item, snapshot } from "../live/fixtures";
 
 const WELD_ARM = {
@@ -172,5 +182,15 @@ describe("display messages", () => {
       ["Place the part", 200],
       ["Take the part", 150],
     ]);
+  });
+});
+
+describe("a cancelled task whose operator may be in the area", () => {
+  it("asks its operator, and nobody else, to say they have left", () => {
+    const state = floor("");
+    const cancelled = item({ id: 101, case: 10, state: "cancelled", claimed_by: 7, in_area: true });
+    expect(nextAction(state, cancelled)).toBe("left-area");
+    expect(nextAction(state, { ...cancelled, claimed_by: 8 })).toBeNull();
+    expect(nextAction(state, { ...cancelled, in_area: false })).toBeNull();
   });
 });

@@ -299,6 +299,22 @@ class WorkItemViewSet(viewsets.ReadOnlyModelViewSet[WorkItem]):
         item = services.reassign_work_item(item, by=_user(request), to=to)
         return Response(self._detail(item))
 
+    @extend_schema(request=None, responses={200: WorkItemDetailSerializer, **WORK_ITEM_REFUSALS})
+    @action(detail=True, methods=["post"], url_path="left-area")
+    def left_area(self, request: Request, pk: str | None = None) -> Response:
+        """Says the operator of a cancelled task has left its shared area: the cobots that
+        operator's presence paused or slowed resume. Its operator, or an engineer or admin of
+        the organisation; a second confirmation changes nothing."""
+        item = selectors.work_items_visible_to(request.user).filter(pk=_item_id(pk)).first()
+        if item is None:
+            raise NotFound(f"There is no work item {pk} in your organisations.")
+        if item.claimed_by_id != request.user.pk and not may_write_in(
+            request.user, item.case.organisation_id
+        ):
+            raise PermissionDenied("Only its operator or a supervisor may say the area is clear.")
+        services.confirm_left_area(item, by=_user(request))
+        return Response(self._detail(item))
+
     @staticmethod
     def _to_steer(request: Request, pk: str | None) -> WorkItem:
         """The work item, for an engineer or admin of its organisation (404 for an outsider)."""

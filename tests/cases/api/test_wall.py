@@ -100,6 +100,7 @@ OBJECT_ENDPOINTS = [
     Endpoint("post", "/api/work-items/{item}/start/"),
     Endpoint("post", "/api/work-items/{item}/complete/", {"data": {}}),
     Endpoint("post", "/api/work-items/{item}/reassign/", {"user": None}),
+    Endpoint("post", "/api/work-items/{item}/left-area/"),
     Endpoint("get", "/api/work-items/{item}/performers/"),
     Endpoint("get", "/api/incidents/{incident}/"),
     Endpoint("post", "/api/incidents/{incident}/resolve/", {"resolution": "cancel"}),
