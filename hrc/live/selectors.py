@@ -170,7 +170,7 @@ def _open_work_items(case_ids: list[int], mappings: dict[int, Any]) -> list[Work
 def _armed_timers(case_ids: list[int]) -> list[TimerData]:
     rows = (
         CaseTimer.objects.filter(case_id__in=case_ids, state=TimerState.ARMED)
-        .order_by("due_at", "id")
+        .order_by("due_at", "case_id", "transition")  # as the tablet's store sorts them
         .values(*TIMER_FIELDS)
     )
     return [payloads.timer_data(row) for row in rows]  # type: ignore[arg-type]
