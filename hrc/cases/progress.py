@@ -548,10 +548,14 @@ def fire_timer(case: Case, net: CaseNet, timer: CaseTimer) -> None:
 
 
 def disarm_timers(case: Case) -> None:
-    """Disarms the case's armed timers (it ended). Call while holding the case row lock."""
-    CaseTimer.objects.filter(case=case, state=TimerState.ARMED).update(
-        state=TimerState.DISARMED, ended_at=timezone.now()
-    )
+    """Disarms the case's armed timers (it ended), each a case event as in arm_timers.
+    Call while holding the case row lock; the caller saves the case."""
+    now = timezone.now()
+    for timer in CaseTimer.objects.filter(case=case, state=TimerState.ARMED):
+        timer.state, timer.ended_at = TimerState.DISARMED, now
+        timer.save(update_fields=["state", "ended_at"])
+        record_event(case, EventType.TIMER_DISARMED, task=timer.transition,
+                     detail=_timer_detail(timer))  # fmt: skip
 
 
 def case_names(case: Case) -> dict[str, Any]:
