@@ -173,7 +173,7 @@ def _armed_timers(case_ids: list[int]) -> list[TimerData]:
         .order_by("due_at", "case_id", "transition")  # as the tablet's store sorts them
         .values(*TIMER_FIELDS)
     )
-    return [payloads.timer_data(row) for row in rows]  # type: ignore[arg-type]
+    return [payloads.timer_data(row) for row in rows]
 
 
 def _open_incidents(case_ids: list[int]) -> list[IncidentData]:

@@ -12,8 +12,8 @@ import pytest
 from django.contrib.auth.models import User
 from playwright.sync_api import Browser, ViewportSize, expect
 
-from hrc.cases import timers
 from hrc.cases import services as case_services
+from hrc.cases import timers
 from hrc.cases.models import CaseTimer
 from hrc.organisations.models import Organisation
 from tests import factories
