@@ -122,8 +122,12 @@ class EventType(models.TextChoices):
     # The case sent a message as a task completed or a transition fired (a "send" key).
     MESSAGE_SENT = "message-sent", "Message sent"
     MESSAGE_RECEIVED = "message-received", "Message received"
+    # A timer transition became enabled: it fires at due_at unless disabled before (disarmed).
+    TIMER_ARMED = "timer-armed", "Timer armed"
     # A timer transition fired: it had been enabled for its duration without interruption.
     TIMER_FIRED = "timer-fired", "Timer fired"
+    # An armed timer's transition was disabled before it was due: it will not fire.
+    TIMER_DISARMED = "timer-disarmed", "Timer disarmed"
     STEP_RETRY = "step-retry", "Step will be retried"
     # A cobot step or device call failed for good: its error; an incident follows.
     STEP_FAILED = "step-failed", "Step failed"

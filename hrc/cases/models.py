@@ -132,6 +132,9 @@ class CaseTimer(models.Model):
 
     case = models.ForeignKey(Case, on_delete=models.CASCADE, related_name="timers")
     transition = models.CharField(max_length=200, help_text="The timer transition's id.")
+    label = models.CharField(
+        max_length=200, blank=True, help_text="The timer transition's label, as tablets show it."
+    )
     state = models.CharField(max_length=10, choices=TimerState.choices, default=TimerState.ARMED)
     armed_at = models.DateTimeField(auto_now_add=True)
     due_at = models.DateTimeField(

@@ -485,7 +485,8 @@ def arm_timers(case: Case, net: CaseNet) -> None:
     """Arms each timer transition the marking enables and no armed timer stands for (due after
     its duration times the case's timer scale; its doorbell rings then), and disarms the armed
     ones whose transition it no longer enables. One that stays enabled keeps its due time.
-    Call while holding the case row lock."""
+    Each is a case event, so a tablet keeps the timers a case waits for from its deltas alone.
+    Call while holding the case row lock; the caller saves the case."""
     if not net.timers:
         return  # most patterns: no query
     waiting = dict(net.waiting_timers(Marking(case.marking)))
@@ -494,12 +495,25 @@ def arm_timers(case: Case, net: CaseNet) -> None:
         if waiting.pop(timer.transition, None) is None:
             timer.state, timer.ended_at = TimerState.DISARMED, now
             timer.save(update_fields=["state", "ended_at"])
+            record_event(case, EventType.TIMER_DISARMED, task=timer.transition,
+                         detail=_timer_detail(timer))  # fmt: skip
     for transition, milliseconds in waiting.items():
         seconds = milliseconds / 1000 * case.timer_scale
         timer = CaseTimer.objects.create(
-            case=case, transition=transition, due_at=now + dt.timedelta(seconds=seconds)
-        )
+            case=case, transition=transition, label=net.labels.get(transition, transition),
+            due_at=now + dt.timedelta(seconds=seconds),
+        )  # fmt: skip
+        record_event(case, EventType.TIMER_ARMED, task=transition, detail=_timer_detail(timer))
         ring_timer_on_commit(timer)
+
+
+def _timer_detail(timer: CaseTimer) -> dict[str, str]:
+    """What a timer event says of its timer: enough for a tablet to show or drop its line."""
+    return {
+        "transition": timer.transition,
+        "label": timer.label or timer.transition,
+        "due_at": timer.due_at.isoformat(),
+    }
 
 
 def ring_timer_on_commit(timer: CaseTimer) -> None:
@@ -521,7 +535,7 @@ def fire_timer(case: Case, net: CaseNet, timer: CaseTimer) -> None:
     timer.save(update_fields=["state", "ended_at"])
     record_event(
         case, EventType.TIMER_FIRED, task=timer.transition, before=before, after=after,
-        detail={"armed_at": timer.armed_at.isoformat(), "due_at": timer.due_at.isoformat()},
+        detail={**_timer_detail(timer), "armed_at": timer.armed_at.isoformat()},
     )  # fmt: skip
     _cancel_emptied(case, net, timer.transition)
     if timer.transition in net.sends:
@@ -534,10 +548,14 @@ def fire_timer(case: Case, net: CaseNet, timer: CaseTimer) -> None:
 
 
 def disarm_timers(case: Case) -> None:
-    """Disarms the case's armed timers (it ended). Call while holding the case row lock."""
-    CaseTimer.objects.filter(case=case, state=TimerState.ARMED).update(
-        state=TimerState.DISARMED, ended_at=timezone.now()
-    )
+    """Disarms the case's armed timers (it ended), each a case event as in arm_timers.
+    Call while holding the case row lock; the caller saves the case."""
+    now = timezone.now()
+    for timer in CaseTimer.objects.filter(case=case, state=TimerState.ARMED):
+        timer.state, timer.ended_at = TimerState.DISARMED, now
+        timer.save(update_fields=["state", "ended_at"])
+        record_event(case, EventType.TIMER_DISARMED, task=timer.transition,
+                     detail=_timer_detail(timer))  # fmt: skip
 
 
 def case_names(case: Case) -> dict[str, Any]:

@@ -84,6 +84,25 @@ class WorkItemDelta(TypedDict):
     item: WorkItemData
 
 
+class TimerData(TypedDict):
+    """An armed timer: its case waits for it until due_at (ISO 8601)."""
+
+    case: int
+    transition: str
+    label: str
+    due_at: str
+
+
+class TimerDelta(TypedDict):
+    """A timer was armed (shown from now), or fired or was disarmed (dropped)."""
+
+    type: Literal["timer"]
+    case: int
+    seq: int
+    event: str  # timer-armed, timer-fired, timer-disarmed
+    timer: TimerData
+
+
 class IncidentDelta(TypedDict):
     type: Literal["incident"]
     case: int
@@ -197,6 +216,7 @@ class Snapshot(TypedDict):
     cases: list[CaseData]
     work_items: list[WorkItemData]
     incidents: list[IncidentData]
+    timers: list[TimerData]  # the armed timers of the open cases, soonest due first
     cobots: list[CobotData]  # the tablet's cell's cobots (every one for the whole floor)
     floor: list[FloorCobot]  # every cobot of the organisation, by id
     stop: CellStopData | None  # the cell's STOP while it holds
@@ -214,10 +234,11 @@ LiveEvent = (
     | CaseDelta
     | WorkItemDelta
     | IncidentDelta
+    | TimerDelta
     | CobotStateDelta
     | CobotQueueDelta
     | CellStopDelta
     | Refused
 )
 # Numbered per case; a tablet checks these for holes.
-CASE_DELTA_TYPES = frozenset({"case", "work-item", "incident"})
+CASE_DELTA_TYPES = frozenset({"case", "work-item", "incident", "timer"})

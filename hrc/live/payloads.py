@@ -25,10 +25,12 @@ from hrc.live.events import (
     CurrentStep,
     IncidentData,
     LiveEvent,
+    TimerData,
     WorkItemData,
 )
 
 _INCIDENT_EVENTS = frozenset({"incident-opened", "incident-resolved"})
+_TIMER_EVENTS = frozenset({"timer-armed", "timer-fired", "timer-disarmed"})
 
 
 def now() -> float:
@@ -88,8 +90,16 @@ class JobRow(TypedDict):
     label: str
 
 
+class TimerRow(TypedDict):
+    case_id: int
+    transition: str
+    label: str
+    due_at: dt.datetime
+
+
 WORK_ITEM_FIELDS = tuple(WorkItemRow.__annotations__)
 INCIDENT_FIELDS = tuple(IncidentRow.__annotations__)
+TIMER_FIELDS = tuple(TimerRow.__annotations__)
 
 
 def case_row(case: Case) -> CaseRow:
@@ -145,6 +155,17 @@ def incident_row(case: Case, item: WorkItem | None, detail: Mapping[str, Any]) -
     }
 
 
+def timer_row(case: Case, detail: Mapping[str, Any]) -> TimerRow:
+    """The timer a `timer-*` event's detail describes (progress._timer_detail)."""
+    transition = str(detail.get("transition") or "")
+    return {
+        "case_id": case.pk,
+        "transition": transition,
+        "label": str(detail.get("label") or transition),
+        "due_at": dt.datetime.fromisoformat(str(detail["due_at"])),
+    }
+
+
 # One builder per payload ---------------------------------------------------------------
 
 
@@ -188,6 +209,15 @@ def incident_data(row: IncidentRow) -> IncidentData:
         "kind": row["kind"],
         "message": row["message"],
         "resolution": row["resolution"],
+    }
+
+
+def timer_data(row: TimerRow) -> TimerData:
+    return {
+        "case": row["case_id"],
+        "transition": row["transition"],
+        "label": row["label"] or row["transition"],
+        "due_at": row["due_at"].isoformat(),
     }
 
 
@@ -265,6 +295,9 @@ def case_delta(
         incident = incident_data(incident_row(case, item, detail or {}))
         return {"type": "incident", "case": case.pk, "seq": seq, "event": event,
                 "incident": incident}  # fmt: skip
+    if event in _TIMER_EVENTS:
+        timer = timer_data(timer_row(case, detail or {}))
+        return {"type": "timer", "case": case.pk, "seq": seq, "event": event, "timer": timer}
     if item is not None:
         started_by = user if event == "task-started" else None
         # Only its cancellation says a task holds the area; what it does next (area-left) ends it.

@@ -18,9 +18,10 @@ from hrc.cases.choices import (
     OPEN_CASE_STATUSES,
     OPEN_WORK_ITEM_STATES,
     JobState,
+    TimerState,
     WorkItemState,
 )
-from hrc.cases.models import Case, Incident, Interruption, Job, WorkItem
+from hrc.cases.models import Case, CaseTimer, Incident, Interruption, Job, WorkItem
 from hrc.cobots.models import CellStop, Cobot
 from hrc.live import cobot_states, payloads
 from hrc.live.events import (
@@ -31,9 +32,10 @@ from hrc.live.events import (
     FloorCobot,
     IncidentData,
     Snapshot,
+    TimerData,
     WorkItemData,
 )
-from hrc.live.payloads import INCIDENT_FIELDS, WORK_ITEM_FIELDS, JobRow
+from hrc.live.payloads import INCIDENT_FIELDS, TIMER_FIELDS, WORK_ITEM_FIELDS, JobRow
 from hrc.organisations.models import Membership, Organisation, Team
 from hrc.organisations.selectors import AnyUser, cells_of
 
@@ -117,6 +119,7 @@ def snapshot(access: Access, cell: str) -> Snapshot:
         "cases": cases,
         "work_items": _open_work_items(case_ids, mappings),
         "incidents": _open_incidents(case_ids),
+        "timers": _armed_timers(case_ids),
         "cobots": [
             CobotData(
                 id=row["id"],
@@ -162,6 +165,15 @@ def _open_work_items(case_ids: list[int], mappings: dict[int, Any]) -> list[Work
         .values(*WORK_ITEM_FIELDS)
     )
     return [payloads.work_item_data(row, mappings.get(row["case_id"])) for row in rows]
+
+
+def _armed_timers(case_ids: list[int]) -> list[TimerData]:
+    rows = (
+        CaseTimer.objects.filter(case_id__in=case_ids, state=TimerState.ARMED)
+        .order_by("due_at", "case_id", "transition")  # as the tablet's store sorts them
+        .values(*TIMER_FIELDS)
+    )
+    return [payloads.timer_data(row) for row in rows]
 
 
 def _open_incidents(case_ids: list[int]) -> list[IncidentData]:

@@ -88,6 +88,24 @@ def test_a_task_done_in_time_disarms_the_timer(
 
 
 @pytest.mark.django_db
+def test_arming_and_disarming_a_timer_are_case_events_naming_it(
+    deadline_version: PatternVersion, operator: User
+) -> None:
+    case = _start(deadline_version, operator, timer_scale=0)
+    item = factories.open_work_item(case, "to1")
+    services.start_work_item(item, user=operator)
+    services.complete_work_item(item, user=operator)
+
+    timer = _timer(case)
+    events = CaseEvent.objects.filter(case=case, type__startswith="timer-").order_by("seq")
+    said = {"transition": "late", "label": "inspection late", "due_at": timer.due_at.isoformat()}
+    assert [(event.type, event.task, event.detail) for event in events] == [
+        (EventType.TIMER_ARMED, "late", said),
+        (EventType.TIMER_DISARMED, "late", said),
+    ]
+
+
+@pytest.mark.django_db
 def test_a_due_timer_fires_once_and_the_case_goes_on(
     deadline_version: PatternVersion, operator: User
 ) -> None:
@@ -101,6 +119,9 @@ def test_a_due_timer_fires_once_and_the_case_goes_on(
     assert timer.state == TimerState.FIRED
     assert timer.ended_at is not None
     assert _fired(case) == ["late"]
+    fired = CaseEvent.objects.get(case=case, type=EventType.TIMER_FIRED)
+    assert fired.detail["due_at"] == timer.due_at.isoformat()
+    assert fired.detail["transition"] == "late"
     # The inspection was only offered: its input emptied, it is withdrawn; rework is offered.
     assert case.work_items.get(task="to1").state == WorkItemState.WITHDRAWN
     rework = factories.open_work_item(case, "to_rework")

@@ -64,5 +64,5 @@ def test_the_union_names_the_same_event_types() -> None:
     literals = {
         typing.get_type_hints(m)["type"].__args__[0] for m in typing.get_args(events.LiveEvent)
     }
-    assert literals == {"snapshot", "case", "work-item", "incident", "cobot-state", "cobot-queue",
+    assert literals == {"snapshot", "case", "work-item", "incident", "timer", "cobot-state", "cobot-queue",
                         "cell-stop", "refused"}  # fmt: skip

@@ -62,6 +62,23 @@ export interface IncidentDelta {
   incident: IncidentData;
 }
 
+/** An armed timer: its case waits for it until due_at (ISO 8601). */
+export interface TimerData {
+  case: number;
+  transition: string;
+  label: string;
+  due_at: string;
+}
+
+/** A timer was armed (shown from now), or fired or was disarmed (dropped). */
+export interface TimerDelta {
+  type: "timer";
+  case: number;
+  seq: number;
+  event: string;
+  timer: TimerData;
+}
+
 export interface CobotStateData {
   cobot: number;
   at: number;
@@ -152,6 +169,7 @@ export interface Snapshot {
   cases: CaseData[];
   work_items: WorkItemData[];
   incidents: IncidentData[];
+  timers: TimerData[]; // the armed timers of the open cases, soonest due first
   cobots: CobotData[];
   floor: FloorCobot[];
   stop: CellStopData | null;
@@ -167,11 +185,12 @@ export type LiveEvent =
   | CaseDelta
   | WorkItemDelta
   | IncidentDelta
+  | TimerDelta
   | CobotStateDelta
   | CobotQueueDelta
   | CellStopDelta
   | Refused;
 
 /** Numbered per case; a tablet checks these for holes. */
-export type CaseStreamDelta = CaseDelta | WorkItemDelta | IncidentDelta;
-export const CASE_DELTA_TYPES: ReadonlySet<string> = new Set(["case", "work-item", "incident"]);
+export type CaseStreamDelta = CaseDelta | WorkItemDelta | IncidentDelta | TimerDelta;
+export const CASE_DELTA_TYPES: ReadonlySet<string> = new Set(["case", "work-item", "incident", "timer"]);

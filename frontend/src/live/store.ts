@@ -18,6 +18,7 @@ import type {
   IncidentData,
   LiveEvent,
   Snapshot,
+  TimerData,
   UserData,
   WorkItemData,
 } from "./events";
@@ -31,6 +32,8 @@ export interface LiveState {
   cases: Map<number, CaseData>;
   workItems: Map<number, WorkItemData>;
   incidents: Map<number, IncidentData>;
+  // The armed timers, by timerKey: the case waits for each until its due_at.
+  timers: Map<string, TimerData>;
   cobots: Map<number, CobotData>;
   // Every cobot of the organisation, with its cell, as of the snapshot.
   floor: Map<number, FloorCobot>;
@@ -80,6 +83,7 @@ export class LiveStore {
       case "case":
       case "work-item":
       case "incident":
+      case "timer":
         return this.applyCaseDelta(event);
       case "cobot-state":
         return this.applyStates(event.states);
@@ -100,6 +104,7 @@ export class LiveStore {
       cases: new Map(snapshot.cases.map((c) => [c.id, c])),
       workItems: new Map(snapshot.work_items.map((w) => [w.id, w])),
       incidents: new Map(snapshot.incidents.map((i) => [i.id, i])),
+      timers: new Map(snapshot.timers.map((t) => [timerKey(t), t])),
       cobots: new Map(snapshot.cobots.map((c) => [c.id, c])),
       floor: new Map(snapshot.floor.map((c) => [c.id, c])),
       stop: snapshot.stop,
@@ -154,6 +159,10 @@ export class LiveStore {
       const shown = OPEN_WORK_ITEM_STATES.has(delta.item.state) || delta.item.in_area;
       if (shown) state.workItems.set(delta.item.id, delta.item);
       else state.workItems.delete(delta.item.id);
+    } else if (delta.type === "timer") {
+      // Armed: shown until it fires or is disarmed (its transition no longer enabled).
+      if (delta.event === "timer-armed") state.timers.set(timerKey(delta.timer), delta.timer);
+      else state.timers.delete(timerKey(delta.timer));
     } else if (delta.incident.resolution === "") {
       state.incidents.set(delta.incident.id, delta.incident);
     } else {
@@ -169,6 +178,7 @@ export class LiveStore {
     for (const [id, incident] of state.incidents) {
       if (incident.case === caseId) state.incidents.delete(id);
     }
+    for (const [key, timer] of state.timers) if (timer.case === caseId) state.timers.delete(key);
   }
 
   private applyStates(states: CobotStateData[]): Outcome {
@@ -210,6 +220,21 @@ export class LiveStore {
   }
 }
 
+/** A case has at most one armed timer per timer transition. */
+export function timerKey(timer: TimerData): string {
+  return `${timer.case}:${timer.transition}`;
+}
+
+/** The armed timers soonest due first, as the snapshot lists them. */
+export function timersByDue(timers: Iterable<TimerData>): TimerData[] {
+  return [...timers].sort(
+    (a, b) =>
+      Date.parse(a.due_at) - Date.parse(b.due_at) ||
+      a.case - b.case ||
+      (a.transition < b.transition ? -1 : a.transition > b.transition ? 1 : 0),
+  );
+}
+
 /** The state in the snapshot's shape, sorted by id: what the event-stream test compares. */
 export function asSnapshot(state: LiveState): Omit<Snapshot, "type"> {
   const byId = <T extends { id: number }>(values: Iterable<T>): T[] =>
@@ -221,6 +246,7 @@ export function asSnapshot(state: LiveState): Omit<Snapshot, "type"> {
     cases: byId(state.cases.values()),
     work_items: byId(state.workItems.values()),
     incidents: byId(state.incidents.values()),
+    timers: timersByDue(state.timers.values()),
     cobots: byId(state.cobots.values()),
     floor: byId(state.floor.values()),
     stop: state.stop,

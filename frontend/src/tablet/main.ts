@@ -21,6 +21,9 @@ import {
   myTasks,
   nextAction,
   teamTasks,
+  timersOf,
+  waitingLine,
+  waitingTimers,
   withDisplayMessages,
 } from "./view";
 
@@ -72,6 +75,7 @@ function render(): void {
   renderCards($(".cards.mine"), myTasks(state), state, "Nothing for you right now.");
   renderCards($(".cards.team"), teamTasks(state), state, "No open team tasks.");
   renderElsewhere(state);
+  renderWaiting(state);
   renderCobots(state);
   renderStop(state);
   renderMessages();
@@ -84,6 +88,20 @@ function renderElsewhere(state: LiveState): void {
   const count = items.length;
   note.hidden = count === 0;
   note.textContent = `${count} more ${count === 1 ? "task waits" : "tasks wait"} for you at ${cellWords(cellsOf(state, items), true)}.`;
+}
+
+function renderWaiting(state: LiveState): void {
+  const timers = waitingTimers(state);
+  const section = $(".waiting");
+  section.hidden = timers.length === 0;
+  section.querySelector("ul")!.replaceChildren(
+    ...timers.map((timer) => {
+      const caseName = state.cases.get(timer.case)?.name ?? "";
+      const line = element("li", "timer", `${caseName ? `${caseName} · ` : ""}case ${timer.case}: ${waitingLine(timer)}`);
+      line.dataset.case = String(timer.case);
+      return line;
+    }),
+  );
 }
 
 function renderCards(container: HTMLElement, items: WorkItemData[], state: LiveState, empty: string): void {
@@ -112,6 +130,7 @@ function card(item: WorkItemData, state: LiveState): HTMLElement {
     // The process, not the operator, ended it: the cobot it held waits for them to be out.
     article.append(element("p", "in-area", "Cancelled. A cobot stays paused until you have left the shared area."));
   }
+  for (const timer of timersOf(state, item.case)) article.append(element("p", "timer", waitingLine(timer)));
   if (item.instructions) article.append(element("p", "instructions", item.instructions));
   const work = cobotWork(state, item);
   if (work.length) {

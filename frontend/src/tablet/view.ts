@@ -1,7 +1,7 @@
 // What the tablet shows, derived from the live state: pure functions, tested without a page.
 
-import type { CobotData, WorkItemData } from "../live/events";
-import type { LiveState } from "../live/store";
+import type { CobotData, TimerData, WorkItemData } from "../live/events";
+import { type LiveState, timersByDue } from "../live/store";
 
 /** Operator tasks that are the user's: claimed or started by them, wherever their case runs, and
  * those offered to them by name at this tablet's cell (see `atThisCell`). */
@@ -52,8 +52,12 @@ export function cellWords(cells: string[], many = false): string {
  * it shows the cases that use one of them, and those that use no cobot, which belong to no cell.
  * A task the user already holds is theirs to finish wherever it is, so callers keep it anyway. */
 export function atThisCell(state: LiveState, item: WorkItemData): boolean {
+  return caseAtThisCell(state, item.case);
+}
+
+function caseAtThisCell(state: LiveState, caseId: number): boolean {
   if (!state.cell) return true;
-  const cobots = state.cases.get(item.case)?.cobots ?? [];
+  const cobots = state.cases.get(caseId)?.cobots ?? [];
   return cobots.length === 0 || cobots.some((id) => state.cobots.has(id));
 }
 
@@ -174,4 +178,22 @@ export function withDisplayMessages(messages: DisplayMessage[], cobots: Iterable
 /** Joint angles in degrees, for the panel. */
 export function degrees(joints: number[]): number[] {
   return joints.map((value) => Math.round((value * 180) / Math.PI));
+}
+
+/** The armed timers of the cases this tablet shows, soonest due first (a case may wait for a
+ * timer with no task open, so they are listed apart from the cards too). */
+export function waitingTimers(state: LiveState): TimerData[] {
+  return timersByDue(state.timers.values()).filter((timer) => caseAtThisCell(state, timer.case));
+}
+
+/** The armed timers the item's case waits for, soonest due first. */
+export function timersOf(state: LiveState, caseId: number): TimerData[] {
+  return timersByDue(state.timers.values()).filter((timer) => timer.case === caseId);
+}
+
+/** "waiting until HH:MM:SS (label)", in the tablet's local time, as the case page says it. */
+export function waitingLine(timer: TimerData): string {
+  const due = new Date(timer.due_at);
+  const clock = [due.getHours(), due.getMinutes(), due.getSeconds()].map((n) => String(n).padStart(2, "0"));
+  return `waiting until ${clock.join(":")} (${timer.label || timer.transition})`;
 }

@@ -1,4 +1,4 @@
-import type { CaseDelta, Snapshot, WorkItemData, WorkItemDelta } from "../../src/live/events";
+import type { CaseDelta, Snapshot, TimerData, TimerDelta, WorkItemData, WorkItemDelta } from "../../src/live/events";
 
 export function snapshot(overrides: Partial<Snapshot> = {}): Snapshot {
   return {
@@ -9,6 +9,7 @@ export function snapshot(overrides: Partial<Snapshot> = {}): Snapshot {
     cases: [{ id: 10, seq: 2, status: "running", name: "Hand-over", cobots: [5] }],
     work_items: [item({ id: 100 })],
     incidents: [],
+    timers: [],
     cobots: [
       {
         id: 5,
@@ -58,4 +59,12 @@ export function caseDelta(caseId: number, seq: number, status: string, event: st
     event,
     data: { id: caseId, seq, status, name: "Hand-over", cobots: [5] },
   };
+}
+
+export function timer(overrides: Partial<TimerData> = {}): TimerData {
+  return { case: 10, transition: "late", label: "Too late", due_at: "2026-01-01T10:20:30+00:00", ...overrides };
+}
+
+export function timerDelta(seq: number, event: string, overrides: Partial<TimerData> = {}): TimerDelta {
+  return { type: "timer", case: 10, seq, event, timer: timer(overrides) };
 }

@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import { asSnapshot, LiveStore } from "../../src/live/store";
-import { caseDelta, itemDelta, snapshot } from "./fixtures";
+import { caseDelta, itemDelta, snapshot, timer, timerDelta } from "./fixtures";
 
 function loaded(): LiveStore {
   const store = new LiveStore();
@@ -112,5 +112,34 @@ describe("cobots and the cell", () => {
     store.apply({ type: "cell-stop", stop: { ...stop, resumed_at: "2026-01-01T00:01:00+00:00", resumed_by: "olivia" } });
     expect(store.state!.stop).toBeNull();
     expect(store.state!.cobots.get(5)!.stopped).toBe(false);
+  });
+});
+
+describe("the timers a case waits for", () => {
+  it("adds an armed timer and drops it when it fires or is disarmed, from the deltas alone", () => {
+    const store = loaded();
+    expect(store.apply(timerDelta(3, "timer-armed"))).toBe("applied");
+    store.apply(timerDelta(4, "timer-armed", { transition: "reminder", due_at: "2026-01-01T10:00:00+00:00" }));
+    expect(asSnapshot(store.state!).timers.map((t) => t.transition)).toEqual(["reminder", "late"]);
+    store.apply(timerDelta(5, "timer-fired", { transition: "reminder", due_at: "2026-01-01T10:00:00+00:00" }));
+    expect(asSnapshot(store.state!).timers.map((t) => t.transition)).toEqual(["late"]);
+    expect(store.state!.cases.get(10)!.seq).toBe(5);
+    store.apply(timerDelta(6, "timer-disarmed"));
+    expect(store.state!.timers.size).toBe(0);
+  });
+
+  it("takes the armed timers from the snapshot, and forgets them when their case ends", () => {
+    const store = new LiveStore();
+    store.apply(snapshot({ timers: [timer()] }));
+    expect([...store.state!.timers.values()]).toEqual([timer()]);
+    store.apply(caseDelta(10, 3, "cancelled", "case-cancelled"));
+    expect(store.state!.timers.size).toBe(0);
+  });
+
+  it("holds a timer delta that comes before the one it follows", () => {
+    const store = loaded();
+    expect(store.apply(timerDelta(4, "timer-fired"))).toBe("held");
+    expect(store.apply(timerDelta(3, "timer-armed"))).toBe("applied");
+    expect(store.state!.timers.size).toBe(0);
   });
 });

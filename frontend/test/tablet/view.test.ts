@@ -10,9 +10,12 @@ import {
   myTasks,
   nextAction,
   teamTasks,
+  timersOf,
+  waitingLine,
+  waitingTimers,
   withDisplayMessages,
 } from "../../src/tablet/view";
-import { item, snapshot } from "../live/fixtures";
+import { item, snapshot, timer } from "../live/fixtures";
 
 const WELD_ARM = {
   id: 5,
@@ -192,5 +195,25 @@ describe("a cancelled task whose operator may be in the area", () => {
     expect(nextAction(state, cancelled)).toBe("left-area");
     expect(nextAction(state, { ...cancelled, claimed_by: 8 })).toBeNull();
     expect(nextAction(state, { ...cancelled, in_area: false })).toBeNull();
+  });
+});
+
+describe("the timers a case waits for", () => {
+  it("reads 'waiting until HH:MM:SS (label)' in the tablet's local time", () => {
+    const due = new Date(2026, 0, 1, 9, 5, 7); // local time
+    expect(waitingLine(timer({ due_at: due.toISOString() }))).toBe("waiting until 09:05:07 (Too late)");
+    expect(waitingLine(timer({ due_at: due.toISOString(), label: "" }))).toBe("waiting until 09:05:07 (late)");
+  });
+
+  it("lists a case's timers on its cards, and the cell's cases' timers apart", () => {
+    const timers = [
+      timer({ case: 10, transition: "b", due_at: "2026-01-01T10:00:02+00:00" }),
+      timer({ case: 10, transition: "a", due_at: "2026-01-01T10:00:01+00:00" }),
+      timer({ case: 11, transition: "c" }),
+    ];
+    const weld = floor("weld", { timers });
+    expect(timersOf(weld, 10).map((t) => t.transition)).toEqual(["a", "b"]);
+    expect(waitingTimers(weld).map((t) => t.transition)).toEqual(["a", "b"]); // case 11 paints
+    expect(waitingTimers(floor("", { timers })).map((t) => t.transition)).toEqual(["a", "b", "c"]);
   });
 });
