@@ -49,7 +49,7 @@ What the mapping does not cover is refused with a FormatError whose messages
 name each element once, by kind, name and id (`task "Check order" (sid-89...)`),
 at every level of the file, and say nothing of the flows that touch a refused
 element: complex gateways, ad-hoc sub-processes, transactions, compensation
-(compensation events, boundary events and handlers), event sub-processes,
+(compensation events, boundary events and handlers), non-interrupting event sub-processes,
 unresolved call activities, inclusive gateways outside a block, choreographies
 and conversations. Nothing else is read from the file, so a refused import
 creates nothing. Positions (BPMNDI) are not read: `layout.lay_out` draws the
