@@ -318,7 +318,10 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
     loaded = str(state.get("CurrentProgram") or "")
     problem = readiness.not_ready(driver.name, state, page=readiness.page_of(cobot_id))
     if problem is not None:
-        raise problem
+        # The incident keeps the cobot's state by node path, as the driver's own errors do
+        # (state() names the variables by their short names): one shape whatever noticed it.
+        by_path = {f"State/{name}": value for name, value in state.items()}
+        raise type(problem)(str(problem), state=by_path)
     # A STOP from a tablet, or an operator entering a shared area, may have paused the
     # program since the lease: playing it again here would undo the pause.
     if Cobot.objects.filter(pk=cobot_id, stopped_at__isnull=False).exists():

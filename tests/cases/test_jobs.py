@@ -122,6 +122,23 @@ def test_a_protective_stop_is_an_incident_that_only_a_person_clears(simulation: 
     assert [t.split()[0] for t in tokens] == [f"{job.pk}.{job.attempt}"]
 
 
+@pytest.mark.parametrize("simulation", [(shared_space(), 0.5)], indirect=True)
+def test_a_stop_found_before_the_step_is_sent_keeps_the_state_as_one_found_during_it(
+    simulation: Simulation,
+) -> None:
+    # The worker's readiness check reads the state by short names; the incident keeps it by
+    # node path, as when the driver notices the stop mid-step: one shape for whoever reads it.
+    cobot = simulation.cobot("c")
+    cobot.call("Simulator/InjectFault", "protective-stop", "")
+    with simulation.running(operators=False):
+        [case_id] = simulation.start_cases(1)
+        case = Case.objects.get(pk=case_id)
+        services.complete_work_item(_do(simulation, case, "to1"), user=simulation.users["o"])
+        incident = until(lambda: Incident.objects.filter(case=case).first())
+        assert incident.cobot_state[urua.STATE_SAFETY_MODE] == "SAFETY_MODE_PROTECTIVE_STOP"
+        assert "SafetyMode" not in incident.cobot_state
+
+
 def _unlocked(cobot: Any) -> bool:
     try:
         cobot.call("Simulator/UnlockProtectiveStop")
