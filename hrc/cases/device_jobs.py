@@ -28,7 +28,7 @@ from django.db import transaction
 from django.db.models import Exists, Q
 from django.utils import timezone
 
-from hrc.cases import dispatch, jobs
+from hrc.cases import dispatch, jobs, progress
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Job
@@ -142,7 +142,8 @@ def _lease_if_ready(
         if waiting:
             jobs.record_waiting(job, waiting)
             return None
-    jobs.take_job(case, net, job, now)
+    progress.lease_job(case, net, job, now, held_by=progress.worker_name())
+    case.save()
     return jobs.Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout,
         device.gateway, sent_before=job.sent_at is not None, device=device,

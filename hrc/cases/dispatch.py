@@ -41,6 +41,7 @@ class Task(StrEnum):
     """The Celery tasks of the cases app, by the names tasks.py registers them under."""
 
     RUN_JOB = "hrc.cases.tasks.run_job"
+    RUN_LEASED_JOB = "hrc.cases.tasks.run_leased_job"
     SWEEP = "hrc.cases.tasks.sweep"
     INTERRUPT_COBOT = "hrc.cases.tasks.interrupt_cobot"
     RESUME_COBOT = "hrc.cases.tasks.resume_cobot"

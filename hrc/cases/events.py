@@ -105,12 +105,13 @@ def record_event(
 ) -> CaseEvent:
     """Appends an event; the case's counter gives its number, so its cost never grows with the log.
 
-    Call while holding the case row lock; the caller saves the case (its last_seq).
+    Call while holding the case row lock; the caller saves the case, which writes the event
+    (Case.save: the log and the case in one statement).
     """
     case.last_seq += 1
     _PUBLISHER.case_event(case, event, item, user, detail)  # the tablets, after commit
     marking = dict(case.marking)
-    return CaseEvent.objects.create(
+    row = CaseEvent(
         case=case, seq=case.last_seq, at=timezone.now(), type=event,
         task=item.task if item else task, actor=item.actor if item else "",
         work_item=item, user=user if user is not None and user.is_authenticated else None,
@@ -118,6 +119,8 @@ def record_event(
         marking_after=dict(after) if after is not None else marking,
         detail=dict(detail or {}),
     )  # fmt: skip
+    case.log(row)  # written with the case, by the caller's case.save()
+    return row
 
 
 def open_incident(

@@ -25,9 +25,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
-import os
-import socket
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -42,13 +40,12 @@ from hrc.cases.choices import (
     CaseStatus,
     EventType,
     IncidentKind,
-    InterruptionMode,
     JobState,
     WorkItemKind,
     WorkItemState,
 )
 from hrc.cases.dispatch import Task
-from hrc.cases.models import Case, Interruption, Job, WorkItem
+from hrc.cases.models import Case, Job, WorkItem
 from hrc.cases.nets import case_net
 from hrc.cases.selectors import holding_work_items, why_held
 from hrc.cobots.control import running_commands
@@ -68,8 +65,6 @@ from hrc_gateway import urua
 
 logger = logging.getLogger(__name__)
 
-# What taking a job changes on its row.
-LEASED_FIELDS = ["state", "lease", "waiting_for", "held_by", "started_at", "lease_expires_at"]
 # Lease expiries of one job after which a person decides (a job that kills its worker).
 MAX_LEASE_EXPIRIES = 3
 
@@ -88,10 +83,46 @@ class Lease:
     cobot: Cobot  # a device job's: the cobot whose gateway serves the device
     sent_before: bool
     device: Device | None = None
+    # Whether a slowdown, or its end, may wait to be sent before the step: a lease taken by a
+    # worker asks (interruptions.set_speed_before_step); a leased job's message says.
+    speed_due: bool = True
+
+    @classmethod
+    def from_message(cls, message: Mapping[str, Any]) -> Lease:
+        """The lease a completion took for a worker (progress.leased_message)."""
+        cobot = message["cobot"]
+        return cls(
+            message["job"], message["case"], message["lease"], message["attempt"],
+            message["kind"], message["command"], message["timeout"],
+            Cobot(**{field: cobot[field] for field in progress.COBOT_FIELDS}),
+            sent_before=False, speed_due=cobot["speed_due"],
+        )  # fmt: skip
+
+
+def run_leased_job(message: Mapping[str, Any]) -> None:
+    """Drives a job a completion leased for the workers (progress.hand_over), once this worker
+    has claimed it: straight to the cobot, the lease in hand. A duplicate of the message (the
+    sweeper sends it again while nobody has claimed it) finds it claimed and does nothing."""
+    lease = Lease.from_message(message)
+    _drive(lambda: lease if _claim(lease) else None)
+
+
+def _claim(lease: Lease) -> bool:
+    """Makes the leased job this worker's, if it is still leased as the message says and no
+    worker has claimed it: one statement, outside any transaction (the lease is the lock)."""
+    claimed = Job.objects.filter(
+        pk=lease.job_id, lease=lease.lease, state=JobState.RUNNING, held_by=""
+    ).update(held_by=progress.worker_name())
+    return bool(claimed)
 
 
 def run_next_job(job_id: int) -> None:
     """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
+    _drive(lambda: _lease_next(Q(jobs__pk=job_id)))
+
+
+def _drive(take: Callable[[], Lease | None]) -> None:
+    """Drives the job `take` leases, if any, and records how it ended."""
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
     # started, the queue) waits until the cobot has accepted the step (events.hold_publishing).
     hold = events.hold_publishing()
@@ -103,7 +134,7 @@ def run_next_job(job_id: int) -> None:
         hold.release()
 
     try:
-        lease = _lease_next(Q(jobs__pk=job_id))
+        lease = take()
         if lease is None:
             return
         try:
@@ -162,7 +193,7 @@ def _lease_next(which: Q) -> Lease | None:
             )
             .annotate(
                 busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
-                paused=Exists(_unsettled_interruptions(cobot)),
+                paused=Exists(progress.unsettled_pauses(cobot)),
                 held=Exists(_held_by_another_case(cobot.pk)),
                 # A person's command (power, program) is under way: no step meanwhile.
                 commanded=Exists(running_commands().filter(cobot=cobot)),
@@ -206,7 +237,8 @@ def _lease_if_ready(
         if record_waiting(job, waiting):
             events.publish_cobot_queue(cobot.pk)
         return None
-    take_job(case, net, job, now)
+    progress.lease_job(case, net, job, now, held_by=progress.worker_name())
+    case.save()
     events.publish_cobot_queue(cobot.pk)
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
@@ -234,20 +266,6 @@ def record_waiting(job: Job, waiting: str) -> bool:
     return True
 
 
-def take_job(case: Case, net: CaseNet, job: Job, now: dt.datetime) -> None:
-    """Leases the job to this worker, starting its task when it is only offered (the cobot or
-    device taking the job is the moment the task starts); saves the job and the case. Call
-    holding both locks, once nothing keeps the job waiting."""
-    if job.work_item.state == WorkItemState.OFFERED:
-        progress.start_cobot_task(case, net, job.work_item)
-    job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
-    job.held_by = f"{socket.gethostname()}:{os.getpid()}"
-    job.started_at = job.started_at or now
-    job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
-    job.save(update_fields=LEASED_FIELDS)
-    case.save()
-
-
 def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     """Why a cobot task must not start now although the marking allows it; "" when it may.
 
@@ -261,14 +279,6 @@ def _why_waiting(case: Case, net: CaseNet, item: WorkItem) -> str:
     return progress.keep_out(case, item, *kept_out)
 
 
-def _unsettled_interruptions(cobot: Cobot | int) -> QuerySet[Interruption]:
-    """The pauses that keep the cobot (or the cobot of that id) from taking a step: not yet
-    over, or not yet resumed. A slowed cobot takes steps (its worker sets their speed)."""
-    return Interruption.objects.filter(cobot=cobot, mode=InterruptionMode.PAUSE).filter(
-        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
-    )
-
-
 def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
     """Drives the job; `on_sent` is called once its step is accepted, or before a device call."""
     driver = driver_for_cobot(lease.cobot, step_timeout=lease.timeout)
@@ -277,7 +287,7 @@ def _execute(lease: Lease, on_sent: Callable[[], None]) -> dict[str, Any]:
         on_sent()  # a call (an inspection, say) may take a while: tablets need not wait for it
         return _call_device(driver, lease)
     _prepare(driver, lease.cobot.pk, command["program"], lease.timeout)
-    if not interruptions.set_speed_before_step(lease.cobot.pk):
+    if lease.speed_due and not interruptions.set_speed_before_step(lease.cobot.pk):
         raise CobotPaused(
             f"{driver.name}'s speed for an operator in its shared area is not set yet; "
             "the step waits until it is."
@@ -329,7 +339,7 @@ def _prepare(driver: SyncDriver, cobot_id: int, program: str, timeout: float) ->
             f"{driver.name}'s cell was stopped from a tablet; the step waits until it is resumed.",
             state=state,
         )
-    if _unsettled_interruptions(cobot_id).exists():
+    if progress.unsettled_pauses(cobot_id).exists():
         raise CobotPaused(
             f"{driver.name} is paused for an operator in a shared area; the step waits until "
             "the operator's task ends.",
@@ -514,13 +524,36 @@ def sweep() -> dict[str, int]:
     for job_id, case_id in expired:
         _expire_lease(job_id, case_id)
     due = _first_due_per_cobot(now)
+    unclaimed = _unclaimed(now)
     with transaction.atomic():  # send_on_commit needs a transaction to wait for
         for job_id in due:
             dispatch.send_on_commit(Task.RUN_JOB, job_id)
+        for message in unclaimed:
+            dispatch.send_on_commit(Task.RUN_LEASED_JOB, message)
         unsettled = interruptions.to_redo()
         for task, interruption_id in unsettled:
             dispatch.send_on_commit(task, interruption_id)
-    return {"expired": len(expired), "rung": len(due), "interruptions": len(unsettled)}
+    return {
+        "expired": len(expired), "rung": len(due), "unclaimed": len(unclaimed),
+        "interruptions": len(unsettled),
+    }  # fmt: skip
+
+
+def _unclaimed(now: dt.datetime) -> list[dict[str, Any]]:
+    """The messages of the jobs a completion leased that no worker has claimed for a sweep's
+    time (their message lost with the broker, or the workers busy): sent again, as a claim
+    takes a lease once. (Unclaimed until it expires, the lease is queued again: _expire_lease.)"""
+    waited = now - dt.timedelta(seconds=settings.HRC_SWEEP_SECONDS)
+    jobs = Job.objects.filter(
+        state=JobState.RUNNING, held_by="", kind=WorkItemKind.STEP, started_at__lt=waited
+    ).select_related("cobot")
+    # speed_due: the worker asks, as the slowdowns may have changed since the lease.
+    return [
+        progress.leased_message(
+            job, {**{f: getattr(job.cobot, f) for f in progress.COBOT_FIELDS}, "speed_due": True}
+        )
+        for job in jobs
+    ]
 
 
 def _first_due_per_cobot(now: dt.datetime) -> list[int]:

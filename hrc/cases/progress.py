@@ -13,12 +13,15 @@ row, then job row, then interruption row.
 from __future__ import annotations
 
 import datetime as dt
+import os
+import socket
 from collections import Counter
 from collections.abc import Mapping
 from typing import Any
 
+from django.conf import settings
 from django.contrib.auth.models import User
-from django.db.models import Exists, OuterRef, Q, Subquery
+from django.db.models import Exists, OuterRef, Q, QuerySet, Subquery
 from django.utils import timezone
 
 from hrc.cases import dispatch
@@ -39,7 +42,9 @@ from hrc.cases.choices import (
 from hrc.cases.dispatch import Task
 from hrc.cases.events import open_incident, record_event
 from hrc.cases.models import Case, CaseTimer, Incident, Interruption, Job, Message, WorkItem
-from hrc.cases.selectors import performable_by
+from hrc.cases.selectors import holding_work_items, performable_by
+from hrc.cobots.control import running_commands
+from hrc.cobots.models import Cobot
 from hrc.engine.commands import cobot_command
 from hrc.engine.petri import Marking
 from hrc.engine.runtime import (
@@ -61,6 +66,8 @@ MAX_ROUNDS = 10_000
 # How long a message waits for a case to take it: one from outside unless it says otherwise,
 # and every message a case sends.
 MESSAGE_TTL_SECONDS = 3600
+# What leasing a job changes on its row.
+LEASED_FIELDS = ["state", "lease", "waiting_for", "held_by", "started_at", "lease_expires_at"]
 # A timer's doorbell is sent only when it is due within this: Redis hands a message not
 # acknowledged within an hour (its visibility timeout) to a worker again, so a doorbell held
 # for days would come back every hour. The sweeper rings the later ones, a sweep late at most.
@@ -270,7 +277,16 @@ def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> 
         open_incident(case, IncidentKind.CASE_FAULT, str(fault), item=item)
         return
     job.save()
-    dispatch.send_on_commit(Task.RUN_JOB, job.pk)
+    jobs_queued_now(case).append(job)
+    # The queue's doorbell, unless hand_over leased the job in this transaction (its message
+    # goes to a worker instead): asked of the row in hand, after the commit.
+    dispatch.send_on_commit_if(lambda: job.state == JobState.QUEUED, Task.RUN_JOB, job.pk)
+
+
+def jobs_queued_now(case: Case) -> list[Job]:
+    """The jobs this transaction queued for the case, in order (hand_over's candidates)."""
+    queued: list[Job] = case.__dict__.setdefault("_jobs_queued_now", [])
+    return queued
 
 
 def _withdraw(case: Case, item: WorkItem, why: str) -> None:
@@ -392,6 +408,109 @@ def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
     start_task(case, net, item, None)
     item.save(update_fields=["state", "started_at"])
     advance(case, net)
+
+
+def lease_job(case: Case, net: CaseNet, job: Job, now: dt.datetime, *, held_by: str) -> None:
+    """Leases the job (its next lease number), starting its task when it is only offered (the
+    cobot or device taking the job is the moment the task starts); saves the job, not the case.
+    `held_by`: the worker's host:pid, or "" for a lease a worker is yet to claim (hand_over).
+    Call holding the case's lock and the job's queue's, once nothing keeps the job waiting."""
+    if job.work_item.state == WorkItemState.OFFERED:
+        start_cobot_task(case, net, job.work_item)
+    job.state, job.lease, job.waiting_for = JobState.RUNNING, job.lease + 1, ""
+    job.held_by = held_by
+    job.started_at = job.started_at or now
+    job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
+    job.save(update_fields=LEASED_FIELDS)
+
+
+def worker_name() -> str:
+    """What a lease's held_by says of this process."""
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def hand_over(case: Case, net: CaseNet) -> None:
+    """Leases each step this transaction queued whose cobot is free now, in this transaction:
+    the completion that enabled a step hands it to a worker in one hop (jobs.run_leased_job
+    claims the lease its message carries and sends the step), instead of a doorbell, then a
+    worker's lease in a transaction of its own.
+
+    Free: no other job queued or running on the cobot, no STOP, no pause for an operator, no
+    other case's func hold, no person's command under way, and the cobot's row not locked: a
+    worker holding it is leasing, and will wait for this case's lock, so the row is taken with
+    SKIP LOCKED and this never waits (the workers' lock order is cobot, then case). A step of a
+    space constraint's task, and every other case, stays queued for its doorbell. Call after
+    advance, holding the case's lock; the caller saves the case."""
+    if case.status != CaseStatus.RUNNING:
+        return
+    marking, now = Marking(case.marking), timezone.now()
+    for job in jobs_queued_now(case):
+        item = job.work_item
+        if (
+            job.state != JobState.QUEUED
+            or job.kind != WorkItemKind.STEP
+            or job.cobot_id is None
+            or item.task in net.space_tasks  # kept out or slowed: the worker's lease decides
+            or item.state != WorkItemState.OFFERED
+            or not net.can_start(marking, item.task)
+        ):
+            continue
+        cobot = _take_free_cobot(job)
+        if cobot is None:
+            continue
+        lease_job(case, net, job, now, held_by="")
+        dispatch.send_on_commit(Task.RUN_LEASED_JOB, leased_message(job, cobot))
+        marking = Marking(case.marking)
+
+
+# What a leased job's message says of its cobot (_take_free_cobot reads it, Lease takes it).
+COBOT_FIELDS = ("id", "organisation_id", "name", "endpoint", "credentials_source")
+
+
+def _take_free_cobot(job: Job) -> dict[str, Any] | None:
+    """Locks the job's cobot (SKIP LOCKED) when it is free for the job (hand_over): its
+    COBOT_FIELDS, and `speed_due`, whether a speed change waits to be sent before its next
+    step; None when it is not free."""
+    assert job.cobot_id is not None  # a step's job is on a cobot
+    cobot = OuterRef("pk")
+    others = Job.objects.filter(cobot=cobot, state__in=[JobState.QUEUED, JobState.RUNNING])
+    free = (
+        Cobot.objects.select_for_update(of=("self",), no_key=True, skip_locked=True)
+        .filter(pk=job.cobot_id, stopped_at__isnull=True)
+        .exclude(Exists(others.exclude(pk=job.pk)))
+        .exclude(Exists(unsettled_pauses(cobot)))
+        .exclude(Exists(holding_work_items().filter(cobot_id=cobot).exclude(case_id=job.case_id)))
+        .exclude(Exists(running_commands().filter(cobot=cobot)))
+        .annotate(speed_due=Exists(speed_changes_due(cobot)))
+        .values(*COBOT_FIELDS, "speed_due")
+    )
+    return next(iter(free), None)
+
+
+def leased_message(job: Job, cobot: Mapping[str, Any]) -> dict[str, Any]:
+    """What a worker needs to drive a job leased for it without reading it again: the lease,
+    the command, and the cobot's COBOT_FIELDS and `speed_due` (jobs.Lease.from_message)."""
+    return {
+        "job": job.pk, "case": job.case_id, "lease": job.lease, "attempt": job.attempt,
+        "kind": job.kind, "command": job.command, "timeout": job.timeout, "cobot": dict(cobot),
+    }  # fmt: skip
+
+
+def unsettled_pauses(cobot: Cobot | int | OuterRef) -> QuerySet[Interruption]:
+    """The pauses that keep the cobot from taking a step: not yet over, or not yet resumed. A
+    slowed cobot takes steps (its worker sets their speed first)."""
+    return Interruption.objects.filter(cobot=cobot, mode=InterruptionMode.PAUSE).filter(
+        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
+    )
+
+
+def speed_changes_due(cobot: Cobot | int | OuterRef) -> QuerySet[Interruption]:
+    """The slowdowns of the cobot whose command or undoing is yet to be sent: a slowdown that
+    ended and has not been restored, or one still open and not yet sent."""
+    return Interruption.objects.filter(cobot=cobot, mode=InterruptionMode.SLOW).filter(
+        Q(ended_at__isnull=False, resumed_at__isnull=True)
+        | Q(ended_at__isnull=True, paused_at__isnull=True)
+    )
 
 
 def complete_cobot_task(

@@ -14,7 +14,7 @@ from django.contrib.auth.models import User
 from django.db import transaction
 from django.utils import timezone
 
-from hrc.cases import progress
+from hrc.cases import events, progress
 from hrc.cases.choices import (
     OPEN_CASE_STATUSES,
     OPEN_WORK_ITEM_STATES,
@@ -270,23 +270,30 @@ def complete_work_item(
     Raises Invalid naming each field the form refuses, Conflict when the task
     is not running (someone completed it already) or a func constraint still holds it.
     """
-    with transaction.atomic():
-        case, item = progress.lock_operator_item(item, user)
-        if item.state != WorkItemState.RUNNING:
-            raise Conflict(_moved_on(item, "completed"))
-        if item.claimed_by_id != user.pk:
-            raise Conflict(f"{item.label} is being done by someone else.")
-        net = case_net(case.version)
-        result = dict(data or {})
-        if fields := form_problems(net.tasks[item.task].form, result):
-            listed = "; ".join(f"{name}: {m}" for name, ms in fields.items() for m in ms)
-            raise Invalid(f"The form is not filled in correctly: {listed}", fields)
-        try:
-            progress.complete_task(case, net, item, result, user)
-        except NotEnabled as refused:
-            raise Conflict(str(refused)) from None
-        progress.advance(case, net)
-        case.save()
+    # The cobot first: what this commits reaches the tablets once the step enabled by it has
+    # gone to a worker (the sender would take the process's time from that send).
+    hold = events.hold_publishing()
+    try:
+        with transaction.atomic():
+            case, item = progress.lock_operator_item(item, user)
+            if item.state != WorkItemState.RUNNING:
+                raise Conflict(_moved_on(item, "completed"))
+            if item.claimed_by_id != user.pk:
+                raise Conflict(f"{item.label} is being done by someone else.")
+            net = case_net(case.version)
+            result = dict(data or {})
+            if fields := form_problems(net.tasks[item.task].form, result):
+                listed = "; ".join(f"{name}: {m}" for name, ms in fields.items() for m in ms)
+                raise Invalid(f"The form is not filled in correctly: {listed}", fields)
+            try:
+                progress.complete_task(case, net, item, result, user)
+            except NotEnabled as refused:
+                raise Conflict(str(refused)) from None
+            progress.advance(case, net)
+            progress.hand_over(case, net)  # a step it enabled goes to a free cobot now
+            case.save()
+    finally:
+        hold.release()
     return item
 
 

@@ -5,6 +5,8 @@ re-reads the rows and does nothing when there is nothing to do. Each is
 registered under its dispatch.Task name, which is how the cases app sends it.
 """
 
+from typing import Any
+
 from celery import shared_task
 
 from hrc.cases import device_jobs, interruptions, jobs, timers
@@ -20,6 +22,12 @@ def run_job(job_id: int) -> None:
         device_jobs.run_next_device_job(job_id)
     else:
         jobs.run_next_job(job_id)
+
+
+@shared_task(name=Task.RUN_LEASED_JOB.value, ignore_result=True)
+def run_leased_job(lease: dict[str, Any]) -> None:
+    """Drives the job a completion leased for the workers; the message is the lease."""
+    jobs.run_leased_job(lease)
 
 
 @shared_task(name=Task.SWEEP.value, ignore_result=True)
