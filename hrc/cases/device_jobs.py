@@ -32,7 +32,7 @@ from hrc.cases import dispatch, jobs, progress
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Job
-from hrc.cases.nets import case_net
+from hrc.cases.nets import net_of
 from hrc.cobots.drivers.base import CommandRefused, DriverError
 from hrc.cobots.drivers.runner import driver_for_cobot
 from hrc.cobots.models import CellStop, Device
@@ -136,7 +136,7 @@ def _lease_if_ready(
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
-    net = case_net(case.version)
+    net = net_of(case)
     if item.state == WorkItemState.OFFERED:
         waiting = net.why_not(Marking(case.marking), f"start:{item.task}")
         if waiting:

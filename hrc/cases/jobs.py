@@ -46,7 +46,7 @@ from hrc.cases.choices import (
 )
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, Job, WorkItem
-from hrc.cases.nets import case_net
+from hrc.cases.nets import net_of
 from hrc.cases.selectors import holding_work_items, why_held
 from hrc.cobots.control import running_commands
 from hrc.cobots.drivers import readiness
@@ -225,7 +225,7 @@ def _lease_if_ready(
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
-    net = case_net(case.version)
+    net = net_of(case)
     # Asked again under the locks: the hold may have ended since the queue was read (it ends
     # in a transaction of its own, then rings the doorbell).
     waiting = why_held(cobot.pk, other_than=case.pk) if held else ""
@@ -400,7 +400,7 @@ def finish_job(
                 case, EventType.CANCELLED_STEP_ENDED, item=job.work_item, detail={"result": result}
             )
         elif case.status in OPEN_CASE_STATUSES:
-            progress.complete_cobot_task(case, case_net(case.version), job.work_item, result)
+            progress.complete_cobot_task(case, net_of(case), job.work_item, result)
         case.save()
         _ring_for_next_on_commit(job)
 
@@ -441,7 +441,7 @@ def fail_job(lease: Lease, error: DriverError, *, accepted_at: dt.datetime | Non
             dispatch.send_on_commit(Task.RUN_JOB, job.pk)
         elif error.transient and job.retries_left > 0:
             job.retries_left -= 1
-            delay = _backoff(case_net(case.version).tasks[item.task].retries - job.retries_left)
+            delay = _backoff(net_of(case).tasks[item.task].retries - job.retries_left)
             job.state, job.next_try_at = (
                 JobState.QUEUED,
                 timezone.now() + dt.timedelta(seconds=delay),

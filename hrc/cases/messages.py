@@ -26,7 +26,7 @@ from hrc.cases import dispatch, progress
 from hrc.cases.choices import CaseStatus
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Case, Message
-from hrc.cases.nets import case_net
+from hrc.cases.nets import case_net, net_of
 from hrc.errors import Conflict, Invalid
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
@@ -109,7 +109,7 @@ def _deliver(message: Message) -> None:
             case = progress.lock_case(case_id)
             if case.status != CaseStatus.RUNNING:
                 continue
-            if progress.take_message(case, case_net(case.version), message.pk):
+            if progress.take_message(case, net_of(case), message.pk):
                 case.save()
                 return
 

@@ -13,6 +13,7 @@ row, then job row, then interruption row.
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import os
 import socket
 from collections import Counter
@@ -21,10 +22,10 @@ from typing import Any
 
 from django.conf import settings
 from django.contrib.auth.models import User
-from django.db.models import Exists, OuterRef, Q, QuerySet, Subquery
+from django.db.models import Exists, OuterRef, Q, QuerySet
 from django.utils import timezone
 
-from hrc.cases import dispatch
+from hrc.cases import dispatch, rows
 from hrc.cases.choices import (
     COMMANDED_MODES,
     OPEN_CASE_STATUSES,
@@ -42,7 +43,7 @@ from hrc.cases.choices import (
 from hrc.cases.dispatch import Task
 from hrc.cases.events import open_incident, record_event
 from hrc.cases.models import Case, CaseTimer, Incident, Interruption, Job, Message, WorkItem
-from hrc.cases.selectors import holding_work_items, performable_by
+from hrc.cases.selectors import holding_work_items
 from hrc.cobots.control import running_commands
 from hrc.cobots.models import Cobot
 from hrc.engine.commands import cobot_command
@@ -59,6 +60,7 @@ from hrc.engine.runtime import (
 )
 from hrc.engine.taskconfig import TaskConfig
 from hrc.errors import Conflict, Invalid, NotAllowed, NotFound
+from hrc.organisations.models import Membership, Team
 
 # advance() repeats settle → messages → held completions until nothing changes;
 # each round consumes a token or a message, so a sound net stops long before this.
@@ -78,49 +80,62 @@ DOORBELL_HORIZON_SECONDS = 600
 
 
 def lock_case(case_id: int) -> Case:
-    """The case, its row locked until the transaction ends (its version read along, not locked)."""
-    return (
-        Case.objects.select_for_update(of=("self",), no_key=True)
-        .select_related("version")
-        .get(pk=case_id)
-    )
+    """The case, its row locked until the transaction ends (its version not read: nets.net_of).
+    Raises Case.DoesNotExist."""
+    case = rows.fetch_one(Case, "id = %s", [case_id], lock="FOR NO KEY UPDATE")
+    if case is None:
+        raise Case.DoesNotExist(f"There is no case {case_id}.")
+    return case
 
 
 def lock_operator_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
     """The case (locked) and a fresh copy of an operator work item the user may perform,
     the case and the user it is claimed by attached.
 
-    The case is found through the item and the user's memberships in the statement
-    that locks it: the organisations' wall costs the API's request no read of its own.
+    The case is found through the item and the user's active membership of its organisation
+    in the statement that locks it: the organisations' wall costs the request no read of its
+    own. The item is read after the lock, in a statement of its own: one that waited for the
+    lock sees what the transaction it waited for committed (READ COMMITTED).
     """
-    item_id = item.pk if isinstance(item, WorkItem) else item
-    case = (
-        Case.objects.select_for_update(of=("self",), no_key=True)
-        .select_related("version")
-        .filter(
-            pk=Subquery(WorkItem.objects.filter(pk=item_id).values("case_id")),
-            organisation__memberships__user_id=user.pk,
-            organisation__memberships__is_active=True,  # deactivated there: not theirs to do
-        )
-        .first()
-    )
+    item_id: int = item.pk if isinstance(item, WorkItem) else item
+    lock_sql, performable_sql = _operator_item_sql()
+    case = rows.fetch_one(Case, lock_sql, [item_id, user.pk], lock="FOR NO KEY UPDATE")
     if case is None:
         raise NotFound(f"There is no work item {item_id} in your organisations.")
-    offered = WorkItem.objects.filter(
-        performable_by(user),
-        pk=OuterRef("pk"),
-        case__organisation__memberships__user_id=user.pk,
-        case__organisation__memberships__is_active=True,
-    )  # a candidate (or in the item's team) and still a member; read with the item in one query
-    item = WorkItem.objects.annotate(performable=Exists(offered)).get(pk=item_id)
+    found = rows.fetch_with(WorkItem, "id = %s", [user.pk, user.pk, item_id], [performable_sql])
+    if not found:  # deleted with its case meanwhile
+        raise NotFound(f"There is no work item {item_id} in your organisations.")
+    [(item, (performable,))] = found
     check_operator_task(item)
-    if not item.performable:
+    if not performable:
         raise NotAllowed(f"{item.label} is not offered to you.")
     # What the caller hands back (the API's answer) reads these; they are in hand.
     item.case = case
     if item.claimed_by_id == user.pk:
         item.claimed_by = user
     return case, item
+
+
+@functools.cache
+def _operator_item_sql() -> tuple[str, str]:
+    """lock_operator_item's conditions in SQL: the case of item %s whose organisation user %s
+    is an active member of; whether the item is offered to user %s (a candidate, or in its
+    team: selectors.performable_by's rule), with the item's table as `items`."""
+    items, cases = rows.table(WorkItem), rows.table(Case)
+    members = rows.table(Membership)
+    candidates = rows.table(WorkItem.candidates.through)
+    teams = rows.table(Team.members.through)
+    lock = (
+        f"id = (SELECT case_id FROM {items} WHERE id = %s) AND EXISTS (SELECT 1 FROM {members} m "
+        f"WHERE m.organisation_id = {cases}.organisation_id AND m.user_id = %s AND m.is_active)"
+    )
+    performable = (
+        f"({items}.kind = '{WorkItemKind.OPERATOR.value}' AND (EXISTS (SELECT 1 FROM {candidates} c "
+        f"WHERE c.workitem_id = {items}.id AND c.user_id = %s) OR EXISTS (SELECT 1 FROM {teams} t "
+        f"JOIN {members} m ON m.id = t.membership_id "
+        f"WHERE t.team_id = {items}.team_id AND m.user_id = %s)))"
+    )
+    return lock, performable
 
 
 def check_operator_task(item: WorkItem) -> None:

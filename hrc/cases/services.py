@@ -27,7 +27,7 @@ from hrc.cases.choices import (
 from hrc.cases.events import record_event
 from hrc.cases.mapping import resolve_actor_mapping
 from hrc.cases.models import Case, Incident, WorkItem
-from hrc.cases.nets import case_net
+from hrc.cases.nets import case_net, net_of
 from hrc.cases.progress import check_operator_task as check_operator_task  # the API asks it too
 from hrc.cases.selectors import performers_of
 from hrc.engine.forms import form_problems
@@ -150,7 +150,7 @@ def resume_case(case: Case, *, by: User | None) -> Case:
             raise Conflict(f"Case {case.pk} is {case.status}, not suspended.")
         case.status = CaseStatus.RUNNING
         record_event(case, EventType.CASE_RESUMED, user=by)
-        progress.advance(case, case_net(case.version))
+        progress.advance(case, net_of(case))
         progress.ring_for_queued_jobs_on_commit(case)
         progress.ring_for_due_timers_on_commit(case)
         case.save()
@@ -238,7 +238,7 @@ def start_work_item(item: WorkItem | int, *, user: User) -> WorkItem:
             raise Conflict(_moved_on(item, "started"))
         if case.status != CaseStatus.RUNNING:
             raise Conflict(f"Case {case.pk} is {case.status}: nothing can start now.")
-        net = case_net(case.version)
+        net = net_of(case)
         kept_out = progress.kept_out_by(case, net, item)
         if kept_out is not None:
             # Recorded and committed, then refused: the refusal is part of the case's history.
@@ -280,7 +280,7 @@ def complete_work_item(
                 raise Conflict(_moved_on(item, "completed"))
             if item.claimed_by_id != user.pk:
                 raise Conflict(f"{item.label} is being done by someone else.")
-            net = case_net(case.version)
+            net = net_of(case)
             result = dict(data or {})
             if fields := form_problems(net.tasks[item.task].form, result):
                 listed = "; ".join(f"{name}: {m}" for name, ms in fields.items() for m in ms)
@@ -337,7 +337,7 @@ def resolve_incident(
             _check_open(case)
             if item is None or item.state not in OPEN_WORK_ITEM_STATES:
                 raise Conflict("Only cancel resolves this incident: it has no open task to retry or skip.")  # fmt: skip
-        net = case_net(case.version)
+        net = net_of(case)
         if resolution == Resolution.CANCEL:
             if case.status in OPEN_CASE_STATUSES:
                 progress.end_as_cancelled(case, by, {"incident": incident.pk})

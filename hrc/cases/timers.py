@@ -21,7 +21,7 @@ from hrc.cases import dispatch, progress
 from hrc.cases.choices import CaseStatus, TimerState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import CaseTimer
-from hrc.cases.nets import case_net
+from hrc.cases.nets import net_of
 from hrc.engine.runtime import NotEnabled
 
 # The sweeper leaves a timer this long past due to its own doorbell.
@@ -44,7 +44,7 @@ def ring_timer(timer_id: int) -> bool:
         if timer.due_at > timezone.now():
             progress.ring_timer_on_commit(timer)
             return False
-        net = case_net(case.version)
+        net = net_of(case)
         try:
             progress.fire_timer(case, net, timer)
         except NotEnabled:  # arm_timers keeps armed timers enabled; should that fail, disarm

@@ -1,0 +1,142 @@
+"""Plain SQL for the rows the hot path reads and writes: a case, its work items, its jobs.
+
+A completion, a lease and a finish each run a handful of statements, and on this stack the
+ORM spends more of a worker's CPU building each one than PostgreSQL spends running it. These
+helpers write the same SQL the ORM would, from the models' own fields (their columns, their
+conversions to and from the database, auto_now_add), with each statement's text built once
+per process. The SQL is portable: on SQLite a row lock is left out, as the ORM leaves it out.
+Everything else keeps using the ORM.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+from django.db import connection
+from django.db.models import Field, Model
+
+M = TypeVar("M", bound=Model)
+Converter = Callable[[Any, Any, Any], Any]
+
+
+def fetch(model: type[M], where: str, params: Sequence[Any], *, lock: str = "") -> list[M]:
+    """The rows of `model` matching `where` (SQL over its table's columns, %s parameters), as
+    instances. `lock` is a row-locking clause ("FOR NO KEY UPDATE", "… SKIP LOCKED"), left out
+    where the database has none."""
+    return [instance for instance, _ in fetch_with(model, where, params, (), lock=lock)]
+
+
+def fetch_one(model: type[M], where: str, params: Sequence[Any], *, lock: str = "") -> M | None:
+    found = fetch(model, where, params, lock=lock)
+    return found[0] if found else None
+
+
+def fetch_with(
+    model: type[M], where: str, params: Sequence[Any], extra: Sequence[str], *, lock: str = ""
+) -> list[tuple[M, tuple[Any, ...]]]:
+    """fetch, each instance with the values of the `extra` SQL expressions read along (their
+    parameters come first in `params`)."""
+    columns, _ = _columns(model, connection.vendor)
+    more = "".join(f", {expression}" for expression in extra)
+    suffix = f" {lock}" if lock and connection.features.has_select_for_update else ""
+    sql = f"SELECT {columns}{more} FROM {table(model)} WHERE {where}{suffix}"
+    width = len(model._meta.concrete_fields)
+    with connection.cursor() as cursor:
+        cursor.execute(sql, list(params))
+        return [(_instance(model, row[:width]), tuple(row[width:])) for row in cursor.fetchall()]
+
+
+def update(instance: Model, fields: Sequence[str]) -> int:
+    """UPDATE of the instance's row: these fields, by its primary key; the rows changed."""
+    model = type(instance)
+    sql, chosen = _update_sql(model, tuple(fields))
+    params = [field.get_db_prep_save(field.pre_save(instance, False), connection) for field in chosen]  # fmt: skip
+    with connection.cursor() as cursor:
+        cursor.execute(sql, [*params, instance.pk])
+        return int(cursor.rowcount)
+
+
+def insert(instance: Model) -> None:
+    """INSERT of a new instance, as Model.save() would (defaults, auto_now_add); sets its pk."""
+    model = type(instance)
+    sql, fields = _insert_sql(model)
+    params = [field.get_db_prep_save(field.pre_save(instance, True), connection) for field in fields]  # fmt: skip
+    with connection.cursor() as cursor:
+        cursor.execute(sql, params)
+        instance.pk = cursor.fetchone()[0]
+    instance._state.adding, instance._state.db = False, connection.alias
+
+
+def table(model: type[Model]) -> str:
+    """The model's table, quoted for SQL."""
+    return connection.ops.quote_name(model._meta.db_table)
+
+
+def _instance(model: type[M], row: Sequence[Any]) -> M:
+    _, converters = _columns(model, connection.vendor)
+    values = list(row)
+    for index, convert in converters:
+        values[index] = convert(values[index])
+    return model.from_db(connection.alias, _attnames(model), values)
+
+
+@functools.cache
+def _attnames(model: type[Model]) -> tuple[str, ...]:
+    return tuple(field.attname for field in model._meta.concrete_fields)
+
+
+@functools.cache
+def _columns(model: type[Model], vendor: str) -> tuple[str, list[tuple[int, Callable[[Any], Any]]]]:
+    """The SELECT list of the model's concrete fields in from_db's order, and the conversions
+    the ORM applies to each value read on that database (JSON decoded; SQLite's dates)."""
+    quote, name = connection.ops.quote_name, table(model)
+    fields = model._meta.concrete_fields
+    converters: list[tuple[int, Callable[[Any], Any]]] = []
+    for index, field in enumerate(fields):
+        column = field.get_col(model._meta.db_table)
+        found: list[Converter] = [
+            *connection.ops.get_db_converters(column),
+            *column.get_db_converters(connection),
+        ]
+        if found:
+            converters.append((index, _chain(found, column)))
+    selected = ", ".join(f"{name}.{quote(_column(field))}" for field in fields)
+    return selected, converters
+
+
+def _chain(converters: list[Converter], column: Any) -> Callable[[Any], Any]:
+    def convert(value: Any) -> Any:
+        for converter in converters:
+            value = converter(value, column, connection)
+        return value
+
+    return convert
+
+
+@functools.cache
+def _update_sql(model: type[Model], names: tuple[str, ...]) -> tuple[str, list[Field[Any, Any]]]:
+    quote = connection.ops.quote_name
+    chosen = [field for field in model._meta.concrete_fields if field.name in names]
+    if len(chosen) != len(set(names)):
+        raise ValueError(f"{model.__name__} has no field among some of {names}.")
+    assignments = ", ".join(f"{quote(_column(field))} = %s" for field in chosen)
+    primary = quote(_column(model._meta.pk))
+    return f"UPDATE {table(model)} SET {assignments} WHERE {primary} = %s", chosen
+
+
+@functools.cache
+def _insert_sql(model: type[Model]) -> tuple[str, list[Field[Any, Any]]]:
+    quote = connection.ops.quote_name
+    fields = [field for field in model._meta.concrete_fields if not field.primary_key]
+    primary = quote(_column(model._meta.pk))
+    sql = (
+        f"INSERT INTO {table(model)} ({', '.join(quote(_column(field)) for field in fields)}) "
+        f"VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}"
+    )
+    return sql, fields
+
+
+def _column(field: Field[Any, Any]) -> str:
+    return field.column or field.attname
