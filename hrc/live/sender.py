@@ -180,7 +180,8 @@ class Sender:
     ) -> None:
         """Sends the batch's deltas, then the queues due (`everything`: all changed so far)."""
         sends = [work for work in batch if isinstance(work, Send)]
-        # The queues the batch changed go in the same frame as its deltas, after them.
+        # The queues due (those the batch changed, unless read within the window) go in the
+        # same frame as its deltas, after them.
         changed = list(dict.fromkeys(w.cobot_id for w in batch if isinstance(w, QueueChanged)))
         due = self.queue_reads.due(changed, time.monotonic(), everything=everything)
         if due:
