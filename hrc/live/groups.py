@@ -5,7 +5,8 @@ each case event through `case_event_on_commit`, the jobs and STOPs say a
 cobot's queue changed through `cobot_queue_on_commit`. Both build their
 payload from the objects the caller holds (hrc.live.payloads), so the hot
 path pays no query: the commit hook only hands it to the sender thread
-(hrc.live.sender), which reads the changed queues once per batch.
+(hrc.live.sender), which reads the changed queues once per batch, a cobot's
+at most once per QUEUE_COALESCE_SECONDS.
 
 Groups: `hrc.org.<organisation>` (every delta from the database: cases,
 work items, incidents, cobot queues, STOPs), `hrc.user.<user>`,

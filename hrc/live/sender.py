@@ -2,7 +2,8 @@
 
 Use hrc.live.groups. One daemon thread per process drains the queue and does
 the group_send, so its Redis round trips never delay the step that caused
-them; it reads the cobot queues that changed once per batch. What one batch
+them; it reads the cobot queues that changed once per batch, and a cobot's
+at most once per QUEUE_COALESCE_SECONDS (QueueReads). What one batch
 holds for the same groups goes in one channel message, encoded once: 200
 tablets cost 200 frames per commit, not 200 encodings per delta.
 
@@ -21,6 +22,7 @@ import logging
 import os
 import queue
 import threading
+import time
 from collections.abc import Callable, Coroutine
 from dataclasses import dataclass, field
 from typing import Any
@@ -42,6 +44,9 @@ FLUSH_TIMEOUT = 10.0
 IDLE_SECONDS = 2.0
 # The longest a hold keeps the sender waiting, released or not.
 HOLD_LIMIT = 0.2
+# A cobot's queue is read and sent at most once in this many seconds per process: a lease and
+# its finish, close together, cost one read (the tablets see the queue this much later at most).
+QUEUE_COALESCE_SECONDS = 0.05
 
 
 @dataclass
@@ -84,11 +89,40 @@ Work = Send | QueueChanged | MembershipEnded | _Flush
 QueueReader = Callable[[list[int]], list[Send]]
 
 
+class QueueReads:
+    """Which changed cobot queues to read now: a cobot read less than QUEUE_COALESCE_SECONDS ago
+    waits for the window's end, and all its changes meanwhile cost that one read."""
+
+    def __init__(self) -> None:
+        self.last_read: dict[int, float] = {}
+        self.deferred: dict[int, float] = {}  # cobot → when its window ends
+
+    def due(self, changed: list[int], now: float, *, everything: bool = False) -> list[int]:
+        """The cobots to read now, from those `changed` and those deferred before;
+        `everything` reads all of them (a flush). Marks them read at `now`."""
+        window = QUEUE_COALESCE_SECONDS
+        for cobot in changed:
+            if cobot not in self.deferred:
+                self.deferred[cobot] = self.last_read.get(cobot, -window) + window
+        ready = [c for c, at in self.deferred.items() if everything or at <= now]
+        for cobot in ready:
+            del self.deferred[cobot]
+            self.last_read[cobot] = now
+        return ready
+
+    def wait(self, now: float) -> float | None:
+        """Seconds until the next deferred read is due; None when none is."""
+        if not self.deferred:
+            return None
+        return max(0.0, min(self.deferred.values()) - now)
+
+
 class Sender:
     """One daemon thread per process that sends what the commit hooks queued, in order."""
 
     def __init__(self, read_queues: QueueReader) -> None:
         self.read_queues = read_queues
+        self.queue_reads = QueueReads()
         self.queue: queue.SimpleQueue[Work] = queue.SimpleQueue()
         self.pid = os.getpid()
         self.holds = 0
@@ -116,34 +150,42 @@ class Sender:
     def _run(self) -> None:
         loop = asyncio.new_event_loop()
         while True:
+            deferred = self.queue_reads.wait(time.monotonic())
             try:
-                batch = [self.queue.get(timeout=IDLE_SECONDS)]
+                batch = [self.queue.get(timeout=IDLE_SECONDS if deferred is None else deferred)]
             except queue.Empty:
-                # Idle: give the queue reads' connection back (it would keep the database busy).
-                connections.close_all()
-                continue
+                if deferred is None:
+                    # Idle: give the queue reads' connection back (it would keep the database busy).
+                    connections.close_all()
+                    continue
+                batch = []  # a deferred queue read is due
             self.open.wait(HOLD_LIMIT)
             while True:  # whatever else is waiting goes in the same batch
                 try:
                     batch.append(self.queue.get_nowait())
                 except queue.Empty:
                     break
+            flushed = [work for work in batch if isinstance(work, _Flush)]
             try:
-                self._send_batch(batch, loop)
+                self._send_batch(batch, loop, everything=bool(flushed))
             except Exception:
                 logger.exception("Live broadcast failed; tablets resynchronise on their next delta")
-            if any(isinstance(work, _Flush) for work in batch):
+            if flushed:
                 connections.close_all()  # whoever waits may be about to drop the database
-            for work in batch:
-                if isinstance(work, _Flush):
-                    work.done.set()
+            for work in flushed:
+                work.done.set()
 
-    def _send_batch(self, batch: list[Work], loop: asyncio.AbstractEventLoop) -> None:
+    def _send_batch(
+        self, batch: list[Work], loop: asyncio.AbstractEventLoop, *, everything: bool
+    ) -> None:
+        """Sends the batch's deltas, then the queues due (`everything`: all changed so far)."""
         sends = [work for work in batch if isinstance(work, Send)]
-        # The queues the batch changed go in the same frame as its deltas, after them.
+        # The queues due (those the batch changed, unless read within the window) go in the
+        # same frame as its deltas, after them.
         changed = list(dict.fromkeys(w.cobot_id for w in batch if isinstance(w, QueueChanged)))
-        if changed:
-            sends += self.read_queues(changed)
+        due = self.queue_reads.due(changed, time.monotonic(), everything=everything)
+        if due:
+            sends += self.read_queues(due)
         if sends:
             run_on_layer(group_send_all(sends), loop)
         ended = [work for work in batch if isinstance(work, MembershipEnded)]

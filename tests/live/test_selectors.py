@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pytest
 from django.contrib.auth.models import User
+from django.db import connection
+from django.test.utils import CaptureQueriesContext
 
 from hrc.cases import jobs
 from hrc.cases.models import Job
@@ -94,3 +96,32 @@ def test_a_cell_tablet_gets_its_cells_cobots_and_where_every_other_cobot_of_ours
         {"id": loose.pk, "name": "spare", "cell": ""},
     ]  # by id; nothing of the other organisation
     assert snapshot(access, "")["floor"] == weld_tablet["floor"]
+
+
+def test_a_snapshot_reads_as_often_for_ten_cobots_cases_and_incidents_as_for_one(
+    organisation: Organisation, engineer: User, operator: User
+) -> None:
+    # A tablet's first message: 200 tablets connecting at a shift change read it at once.
+    version = factories.make_version(organisation, published_by=engineer)
+
+    def floor(count: int) -> None:  # a cobot with a queued step, an incident, an operator's task
+        for _ in range(count):
+            cobot = factories.make_cobot(organisation, cell="weld")
+            case = factories.hand_over_case(version, started_by=operator, operator=operator,
+                                            cobot=cobot)  # fmt: skip
+            factories.make_incident(factories.open_work_item(case, "tc1"))
+            factories.make_case(version, started_by=operator,
+                                actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}})  # fmt: skip
+
+    def statements() -> int:
+        access = access_of(operator, organisation.pk)
+        assert access is not None
+        with CaptureQueriesContext(connection) as captured:
+            shown = snapshot(access, "weld")
+        assert len(shown["cobots"]) == len(shown["incidents"]) == len(shown["cases"]) // 2
+        return len(captured.captured_queries)
+
+    floor(1)
+    one = statements()
+    floor(9)
+    assert statements() == one

@@ -172,8 +172,13 @@ class WorkItemSerializer(serializers.ModelSerializer[WorkItem]):
         job = getattr(item, "job", None)
         if job is None:
             return None
-        # The position is annotated on the work item (selectors.work_items_visible_to).
+        # The position is annotated on the work item (selectors.work_items_visible_to), and
+        # the job's cobot or device is the item's, read along: no query per row for its name.
         job.queue_position = getattr(item, "queue_position", None)
+        if job.cobot_id == item.cobot_id and WorkItem.cobot.is_cached(item):
+            job.cobot = item.cobot
+        if job.device_id == item.device_id and WorkItem.device.is_cached(item):
+            job.device = item.device
         return JobSerializer(job).data
 
 
