@@ -10,11 +10,12 @@ from typing import Any
 
 from django.contrib.auth.models import User
 from django.db import transaction
+from django.utils import timezone
 
 from hrc.cases import events as case_events
 from hrc.cases import services as case_services
-from hrc.cases.choices import OPEN_WORK_ITEM_STATES, IncidentKind
-from hrc.cases.models import Case, Incident, WorkItem
+from hrc.cases.choices import OPEN_WORK_ITEM_STATES, IncidentKind, JobState
+from hrc.cases.models import Case, Incident, Job, WorkItem
 from hrc.cobots import services as cobot_services
 from hrc.cobots.choices import DriverKind
 from hrc.cobots.models import Cobot
@@ -220,7 +221,8 @@ def hand_over_case(
     version: PatternVersion, *, started_by: User, operator: User, cobot: Cobot
 ) -> Case:
     """A case of the hand-over pattern (valid_document()) whose operator has prepared the
-    workpiece (to1 done): its cobot step waits in the cobot's queue."""
+    workpiece (to1 done): its cobot step is leased for the workers when the cobot was free
+    (the completion hands it over; no worker has claimed it), else it waits in the queue."""
     case = make_case(
         version, started_by=started_by,
         actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
@@ -237,9 +239,11 @@ def open_work_item(case: Case, task: str) -> WorkItem:
 
 
 def make_incident(item: WorkItem, message: str = "The step failed.") -> Incident:
-    """An open incident about a work item, as a worker opens one (holding the case row lock)."""
+    """An open incident about a work item, as a worker opens one (holding the case row lock):
+    the item's job, if it has one, failed."""
     with transaction.atomic():
         case = Case.objects.select_for_update().get(pk=item.case_id)
+        Job.objects.filter(work_item=item).update(state=JobState.FAILED, ended_at=timezone.now())
         incident = case_events.open_incident(
             case, IncidentKind.STEP_FAILED, message, item=item, cobot_state={"RobotMode": 7}
         )

@@ -25,10 +25,10 @@ from typing import Any
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import Exists, Q
+from django.db.models import Exists, Q, QuerySet
 from django.utils import timezone
 
-from hrc.cases import dispatch, jobs, progress
+from hrc.cases import dispatch, jobs, progress, rows
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Job
@@ -46,7 +46,12 @@ DEVICE_SESSION = "devices"
 
 def is_device_job(job_id: int) -> bool:
     """Whether the job is a device's (its doorbell rings the device's queue)."""
-    return Job.objects.filter(pk=job_id, device__isnull=False).exists()
+    return bool(_on_a_device(job=job_id))
+
+
+@rows.compiled
+def _on_a_device(job: int) -> QuerySet[Job, Any]:  # asked on every doorbell: compiled once
+    return Job.objects.filter(pk=job, device__isnull=False).values_list("pk")
 
 
 def run_next_device_job(job_id: int) -> None:

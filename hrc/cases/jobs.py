@@ -31,10 +31,10 @@ from typing import Any
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import Exists, OuterRef, Q, QuerySet
+from django.db.models import Exists, OuterRef, QuerySet
 from django.utils import timezone
 
-from hrc.cases import dispatch, events, interruptions, progress
+from hrc.cases import dispatch, events, interruptions, progress, rows
 from hrc.cases.choices import (
     OPEN_CASE_STATUSES,
     CaseStatus,
@@ -118,7 +118,9 @@ def _claim(lease: Lease) -> bool:
 
 def run_next_job(job_id: int) -> None:
     """Runs the next job of `job_id`'s cobot, if one may run now; safe to call any number of times."""
-    _drive(lambda: _lease_next(Q(jobs__pk=job_id)))
+    _drive(
+        lambda: _lease_next(f"id = (SELECT cobot_id FROM {rows.table(Job)} WHERE id = %s)", job_id)
+    )
 
 
 def _drive(take: Callable[[], Lease | None]) -> None:
@@ -157,16 +159,23 @@ def _drive(take: Callable[[], Lease | None]) -> None:
 
 
 def lease_next_job(cobot_id: int) -> Lease | None:
-    """Leases the cobot's first queued job that may start now; None when none may.
+    """The lease of the cobot's next job, taken for this process: a job a completion leased
+    for the workers that none has claimed (claimed now), else the first queued job that may
+    start now (leased now); None when there is none.
 
-    Starting the job's task (its `start` firing) happens here, in the same
+    Starting the job's task (its `start` firing) happens with the lease, in the same
     transaction: the cobot taking the job is the moment the task starts.
     """
-    return _lease_next(Q(pk=cobot_id))
+    for message in _unclaimed(timezone.now(), cobot_id=cobot_id):
+        lease = Lease.from_message(message)
+        if _claim(lease):
+            return lease
+    return _lease_next("id = %s", cobot_id)
 
 
-def _lease_next(which: Q) -> Lease | None:
-    """`lease_next_job` for the cobot `which` selects (by its own id, or by one of its jobs')."""
+def _lease_next(which: str, key: int) -> Lease | None:
+    """`lease_next_job` for the cobot `which` selects (SQL over the cobot's columns, `key` its
+    parameter: the cobot's own id, or one of its jobs')."""
     now = timezone.now()
     with transaction.atomic():
         # The lock first, then the reasons to wait in a statement of their own: a statement
@@ -177,7 +186,7 @@ def _lease_next(which: Q) -> Lease | None:
         # wait for it while we wait for the case, a deadlock.
         # A locked row is read as it is now, whatever the statement's snapshot: its own
         # columns (stopped_at) may come with the lock.
-        cobot = Cobot.objects.select_for_update(of=("self",), no_key=True).filter(which).first()
+        cobot = rows.fetch_one(Cobot, which, [key], lock="FOR NO KEY UPDATE")
         if cobot is None:
             return None
         if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.cobots.stops)
@@ -186,29 +195,34 @@ def _lease_next(which: Q) -> Lease | None:
         # operator in a shared area) on each row: a second statement, so they are fresh.
         # `held`: another case's func hold reserves the cobot; the holding case's own jobs
         # may go (its pattern may give the cobot the supported task itself).
-        queued = (
-            Job.objects.filter(
-                cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now,
-                case__status=CaseStatus.RUNNING,
-            )
-            .annotate(
-                busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
-                paused=Exists(progress.unsettled_pauses(cobot)),
-                held=Exists(_held_by_another_case(cobot.pk)),
-                # A person's command (power, program) is under way: no step meanwhile.
-                commanded=Exists(running_commands().filter(cobot=cobot)),
-            )
-            .values_list("pk", "case_id", "busy", "paused", "held", "commanded")[
-                : settings.HRC_QUEUE_LOOKAHEAD
-            ]
-        )  # fmt: skip
-        for job_id, case_id, busy, paused, held, commanded in list(queued):
+        queued = _queue(cobot=cobot.pk, now=now)
+        for job_id, case_id, busy, paused, held, commanded, speed_due in queued:
             if busy or paused or commanded:
                 return None
-            lease = _lease_if_ready(cobot, job_id, case_id, now, held=held)
+            lease = _lease_if_ready(cobot, job_id, case_id, now, held=held, speed_due=speed_due)
             if lease is not None:
                 return lease
     return None
+
+
+@rows.compiled
+def _queue(cobot: int, now: dt.datetime) -> QuerySet[Job, Any]:
+    """The cobot's queue, with the reasons the whole cobot waits on each row (a job running, a
+    pause for an operator in a shared area, a person's command (power, program) under way).
+    `held`: another case's func hold reserves the cobot; the holding case's own jobs may go
+    (its pattern may give the cobot the supported task itself). `speed_due`: a slowdown or its
+    end waits to be sent (the worker sends it before the step)."""
+    return Job.objects.filter(
+        cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING,
+    ).annotate(
+        busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
+        paused=Exists(progress.unsettled_pauses(cobot)),
+        held=Exists(_held_by_another_case(cobot)),
+        commanded=Exists(running_commands(now).filter(cobot=cobot)),
+        speed_due=Exists(progress.speed_changes_due(cobot)),
+    ).values_list("pk", "case_id", "busy", "paused", "held", "commanded", "speed_due")[
+        : settings.HRC_QUEUE_LOOKAHEAD
+    ]  # fmt: skip
 
 
 def _held_by_another_case(cobot_id: int | OuterRef) -> QuerySet[WorkItem]:
@@ -217,10 +231,10 @@ def _held_by_another_case(cobot_id: int | OuterRef) -> QuerySet[WorkItem]:
 
 
 def _lease_if_ready(
-    cobot: Cobot, job_id: int, case_id: int, now: dt.datetime, *, held: bool
+    cobot: Cobot, job_id: int, case_id: int, now: dt.datetime, *, held: bool, speed_due: bool
 ) -> Lease | None:
-    """Leases the job when it may start now, else records why it waits; `held` is the queue
-    statement's word that another case's func hold reserved the cobot (asked again here)."""
+    """Leases the job when it may start now, else records why it waits; `held` and `speed_due`
+    are the queue statement's (_queue; a hold is asked again here)."""
     case, job = lock_case_and_job(case_id, job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
@@ -243,17 +257,17 @@ def _lease_if_ready(
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
         sent_before=job.sent_at is not None,
+        # Starting a space constraint's task may have slowed it for an operator just now.
+        speed_due=speed_due or item.task in net.space_tasks,
     )  # fmt: skip
 
 
 def lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
     """Both rows locked, in the project's lock order (case, then job); the work item read along."""
     case = progress.lock_case(case_id)
-    job = (
-        Job.objects.select_for_update(of=("self",), no_key=True)
-        .select_related("work_item")
-        .get(pk=job_id)
-    )
+    job = rows.fetch_one_with(Job, "work_item", f"{rows.table(Job)}.id = %s", [job_id], lock="FOR NO KEY UPDATE")  # fmt: skip
+    if job is None:
+        raise Job.DoesNotExist(f"There is no job {job_id}.")
     return case, job
 
 
@@ -394,7 +408,7 @@ def finish_job(
             return
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
         job.accepted_at = accepted_at or job.started_at
-        job.save(update_fields=["state", "result", "ended_at", "accepted_at"])
+        rows.update(job, ["state", "result", "ended_at", "accepted_at"])
         if job.work_item.state == WorkItemState.CANCELLED:
             events.record_event(
                 case, EventType.CANCELLED_STEP_ENDED, item=job.work_item, detail={"result": result}
@@ -539,14 +553,18 @@ def sweep() -> dict[str, int]:
     }  # fmt: skip
 
 
-def _unclaimed(now: dt.datetime) -> list[dict[str, Any]]:
-    """The messages of the jobs a completion leased that no worker has claimed for a sweep's
-    time (their message lost with the broker, or the workers busy): sent again, as a claim
-    takes a lease once. (Unclaimed until it expires, the lease is queued again: _expire_lease.)"""
-    waited = now - dt.timedelta(seconds=settings.HRC_SWEEP_SECONDS)
-    jobs = Job.objects.filter(
-        state=JobState.RUNNING, held_by="", kind=WorkItemKind.STEP, started_at__lt=waited
-    ).select_related("cobot")
+def _unclaimed(now: dt.datetime, cobot_id: int | None = None) -> list[dict[str, Any]]:
+    """The messages of the jobs a completion leased that no worker has claimed: for the sweeper
+    (no `cobot_id`), those a sweep's time old (their message lost with the broker, or the
+    workers busy), which it sends again, as a claim takes a lease once; else the cobot's. (Left
+    unclaimed until the lease expires, a job is queued again: _expire_lease.)"""
+    jobs = Job.objects.filter(state=JobState.RUNNING, held_by="", kind=WorkItemKind.STEP)
+    if cobot_id is None:
+        waited = now - dt.timedelta(seconds=settings.HRC_SWEEP_SECONDS)
+        jobs = jobs.filter(started_at__lt=waited)
+    else:
+        jobs = jobs.filter(cobot_id=cobot_id)
+    jobs = jobs.select_related("cobot").order_by("started_at", "id")
     # speed_due: the worker asks, as the slowdowns may have changed since the lease.
     return [
         progress.leased_message(

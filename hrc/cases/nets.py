@@ -33,6 +33,13 @@ def net_of(case: Case) -> CaseNet:
     return _net(case.version_id, lambda: case.version)
 
 
+def compiled_net(version_id: int) -> CaseNet | None:
+    """The version compiled if this process has compiled it already, else None: never a query
+    (what a case event's broadcast reads, inside the transaction that recorded it)."""
+    with _guard:
+        return _compiled.get(version_id)
+
+
 def _net(version_id: int, version: Callable[[], PatternVersion]) -> CaseNet:
     # Keyed by id: a version's document is immutable, so its compiled net is too.
     with _guard:

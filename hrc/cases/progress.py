@@ -43,6 +43,7 @@ from hrc.cases.choices import (
 from hrc.cases.dispatch import Task
 from hrc.cases.events import open_incident, record_event
 from hrc.cases.models import Case, CaseTimer, Incident, Interruption, Job, Message, WorkItem
+from hrc.cases.nets import net_of
 from hrc.cases.selectors import holding_work_items
 from hrc.cobots.control import running_commands
 from hrc.cobots.models import Cobot
@@ -218,10 +219,7 @@ def _complete_held_steps(case: Case, net: CaseNet) -> bool:
 
 def _offer_and_withdraw(case: Case, net: CaseNet, marking: Marking) -> None:
     startable = set(net.startable(marking))
-    open_items = {
-        item.task: item
-        for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES)
-    }
+    open_items = {item.task: item for item in open_work_items(case)}
     for task, item in open_items.items():
         if item.state != WorkItemState.RUNNING and task not in startable:
             _withdraw(case, item, "another task took its turn")
@@ -241,17 +239,25 @@ def _offer_and_withdraw(case: Case, net: CaseNet, marking: Marking) -> None:
         )
 
 
+def open_work_items(case: Case) -> list[WorkItem]:
+    """The case's work items not yet ended, oldest first."""
+    states = sorted(OPEN_WORK_ITEM_STATES)
+    where = f"case_id = %s AND state IN ({', '.join(['%s'] * len(states))}) ORDER BY offered_at, id"
+    return rows.fetch(WorkItem, where, [case.pk, *states])
+
+
 def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
     config = net.tasks[task]
     actor = net.performers[task]
     binding = case.actor_mapping[actor]
     device_id = _device_of(binding, config)
-    item = WorkItem.objects.create(
+    item = WorkItem(
         case=case, task=task, label=net.labels[task], actor=actor,
         kind=config.kind, instructions=config.instructions, team_id=binding.get("team"),
         # A device call is its device's work: the cobot's queue stays free meanwhile.
         cobot_id=None if device_id else binding.get("cobot"), device_id=device_id,
     )  # fmt: skip
+    rows.insert(item)
     if config.kind == "operator":
         # A new item has no candidates yet: insert them in one statement.
         Candidate = WorkItem.candidates.through
@@ -291,7 +297,7 @@ def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> 
         job.save()
         open_incident(case, IncidentKind.CASE_FAULT, str(fault), item=item)
         return
-    job.save()
+    rows.insert(job)
     jobs_queued_now(case).append(job)
     # The queue's doorbell, unless hand_over leased the job in this transaction (its message
     # goes to a worker instead): asked of the row in hand, after the commit.
@@ -318,7 +324,7 @@ def _close(case: Case, item: WorkItem, state: WorkItemState) -> None:
         if held is not None:  # the item ends while its func constraint holds the cobot
             _end_hold(held)
     item.state, item.ended_at = state, timezone.now()
-    item.save(update_fields=["state", "ended_at"])
+    rows.update(item, ["state", "ended_at"])
     Job.objects.filter(work_item=item, state__in=[JobState.QUEUED, JobState.FAILED]).update(
         state=JobState.CANCELLED, ended_at=item.ended_at
     )
@@ -407,7 +413,7 @@ def complete_task(
     case.marking = dict(after)
     item.state, item.ended_at = WorkItemState.COMPLETED, timezone.now()
     item.result, item.completed_by = dict(result), user
-    item.save(update_fields=["state", "ended_at", "result", "completed_by", "started_at"])
+    rows.update(item, ["state", "ended_at", "result", "completed_by", "started_at"])
     record_event(case, EventType.TASK_COMPLETED, item=item, user=user, before=before, after=after)
     if message is not None:
         send_message(case, message, item.task)
@@ -421,7 +427,7 @@ def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
     Call while holding the case row lock, with the start enabled; the caller saves the case.
     """
     start_task(case, net, item, None)
-    item.save(update_fields=["state", "started_at"])
+    rows.update(item, ["state", "started_at"])
     advance(case, net)
 
 
@@ -436,7 +442,7 @@ def lease_job(case: Case, net: CaseNet, job: Job, now: dt.datetime, *, held_by: 
     job.held_by = held_by
     job.started_at = job.started_at or now
     job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
-    job.save(update_fields=LEASED_FIELDS)
+    rows.update(job, LEASED_FIELDS)
 
 
 def worker_name() -> str:
@@ -487,19 +493,24 @@ def _take_free_cobot(job: Job) -> dict[str, Any] | None:
     COBOT_FIELDS, and `speed_due`, whether a speed change waits to be sent before its next
     step; None when it is not free."""
     assert job.cobot_id is not None  # a step's job is on a cobot
-    cobot = OuterRef("pk")
-    others = Job.objects.filter(cobot=cobot, state__in=[JobState.QUEUED, JobState.RUNNING])
-    free = (
+    found = _free_cobot(cobot=job.cobot_id, job=job.pk, case=job.case_id, now=timezone.now())
+    return dict(zip((*COBOT_FIELDS, "speed_due"), found[0], strict=True)) if found else None
+
+
+@rows.compiled
+def _free_cobot(cobot: int, job: int, case: int, now: dt.datetime) -> QuerySet[Cobot, Any]:
+    here = OuterRef("pk")
+    others = Job.objects.filter(cobot=here, state__in=[JobState.QUEUED, JobState.RUNNING])
+    return (
         Cobot.objects.select_for_update(of=("self",), no_key=True, skip_locked=True)
-        .filter(pk=job.cobot_id, stopped_at__isnull=True)
-        .exclude(Exists(others.exclude(pk=job.pk)))
-        .exclude(Exists(unsettled_pauses(cobot)))
-        .exclude(Exists(holding_work_items().filter(cobot_id=cobot).exclude(case_id=job.case_id)))
-        .exclude(Exists(running_commands().filter(cobot=cobot)))
-        .annotate(speed_due=Exists(speed_changes_due(cobot)))
-        .values(*COBOT_FIELDS, "speed_due")
+        .filter(pk=cobot, stopped_at__isnull=True)
+        .exclude(Exists(others.exclude(pk=job)))
+        .exclude(Exists(unsettled_pauses(here)))
+        .exclude(Exists(holding_work_items().filter(cobot_id=here).exclude(case_id=case)))
+        .exclude(Exists(running_commands(now).filter(cobot=here)))
+        .annotate(speed_due=Exists(speed_changes_due(here)))
+        .values_list(*COBOT_FIELDS, "speed_due")
     )
-    return next(iter(free), None)
 
 
 def leased_message(job: Job, cobot: Mapping[str, Any]) -> dict[str, Any]:
@@ -844,10 +855,12 @@ def ring_for_next_job_on_commit(job_id: int, cobot_id: int) -> None:
     transaction to find nothing. Asked after the commit, so none is missed: a job queued
     meanwhile rang its own doorbell, which found the cobot busy, after it had committed."""
 
-    def queued() -> bool:
-        return Job.objects.filter(cobot_id=cobot_id, state=JobState.QUEUED).exists()
+    dispatch.send_on_commit_if(lambda: bool(_queued_on(cobot=cobot_id)), Task.RUN_JOB, job_id)
 
-    dispatch.send_on_commit_if(queued, Task.RUN_JOB, job_id)
+
+@rows.compiled
+def _queued_on(cobot: int) -> QuerySet[Job, Any]:  # asked after each step: compiled once
+    return Job.objects.filter(cobot_id=cobot, state=JobState.QUEUED).values_list("pk")[:1]
 
 
 def ring_for_due_timers_on_commit(case: Case) -> None:
@@ -916,10 +929,13 @@ def skip_task(case: Case, net: CaseNet, item: WorkItem, outputs: dict[str, Any],
 
 def end_case(case: Case, status: str, event: str, by: User | None, detail: dict[str, Any]) -> None:
     """Ends the case with `status`: open work is withdrawn, its interruptions end."""
-    for item in WorkItem.objects.filter(case=case, state__in=OPEN_WORK_ITEM_STATES):
+    for item in open_work_items(case):
         _withdraw(case, item, f"the case is {status}")
-    _end_interruptions(case, Q())
-    disarm_timers(case)
+    net = net_of(case)
+    if net.space_tasks:  # only a space constraint's tasks are ever interrupted
+        _end_interruptions(case, Q())
+    if net.timers:
+        disarm_timers(case)
     case.status, case.ended_at = status, timezone.now()
     record_event(case, event, user=by, detail=detail)
 

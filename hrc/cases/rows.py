@@ -10,15 +10,20 @@ Everything else keeps using the ORM.
 
 from __future__ import annotations
 
+import datetime as dt
 import functools
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
 from django.db import connection
-from django.db.models import Field, Model
+from django.db.models import Field, Model, QuerySet
 
 M = TypeVar("M", bound=Model)
 Converter = Callable[[Any, Any, Any], Any]
+# Stand-ins for a compiled query's values (see compiled): none is a value a query meets.
+_FIRST_STAND_IN = -7_100_000_000
+_STAND_IN_EPOCH = dt.datetime(1901, 1, 1, tzinfo=dt.UTC)
+_STAND_IN_SPACING = dt.timedelta(days=3650)  # a value may be offset by less than half of this
 
 
 def fetch(model: type[M], where: str, params: Sequence[Any], *, lock: str = "") -> list[M]:
@@ -46,6 +51,33 @@ def fetch_with(
     with connection.cursor() as cursor:
         cursor.execute(sql, list(params))
         return [(_instance(model, row[:width]), tuple(row[width:])) for row in cursor.fetchall()]
+
+
+def fetch_one_with(
+    model: type[M], relation: str, where: str, params: Sequence[Any], *, lock: str = ""
+) -> M | None:
+    """fetch_one, the row its foreign key `relation` points to read along in the same statement
+    (a join, as select_related); `lock` locks the model's row only."""
+    field = model._meta.get_field(relation)
+    related: type[Model] = field.related_model  # type: ignore[assignment]
+    mine, _ = _columns(model, connection.vendor)
+    theirs, _ = _columns(related, connection.vendor)
+    quote = connection.ops.quote_name
+    join = (
+        f"{table(related)} ON {table(related)}.{quote(_column(related._meta.pk))} = "
+        f"{table(model)}.{quote(str(field.column))}"  # type: ignore[union-attr]
+    )
+    suffix = f" {lock} OF {table(model)}" if lock and connection.features.has_select_for_update else ""  # fmt: skip
+    sql = f"SELECT {mine}, {theirs} FROM {table(model)} JOIN {join} WHERE {where}{suffix}"
+    with connection.cursor() as cursor:
+        cursor.execute(sql, list(params))
+        row = cursor.fetchone()
+    if row is None:
+        return None
+    width = len(model._meta.concrete_fields)
+    instance = _instance(model, row[:width])
+    setattr(instance, relation, _instance(related, row[width:]))
+    return instance
 
 
 def update(instance: Model, fields: Sequence[str]) -> int:
@@ -140,3 +172,64 @@ def _insert_sql(model: type[Model]) -> tuple[str, list[Field[Any, Any]]]:
 
 def _column(field: Field[Any, Any]) -> str:
     return field.column or field.attname
+
+
+class Compiled:
+    """An ORM query compiled to SQL once per process (on PostgreSQL), then run with new values:
+    the rule stays written once, with the ORM, and the hot path pays only for running it.
+
+    `build(**values)` returns the query (a values_list). It is compiled with a stand-in for
+    each value (an int, or a datetime: a value derived from one by an offset, such as "now
+    less five minutes", keeps its offset); each parameter of the SQL that is a stand-in is
+    then replaced by the value given. A query whose SQL depends on the values themselves (a
+    list whose length varies) cannot be compiled so.
+    """
+
+    def __init__(self, build: Callable[..., QuerySet[Any, Any]]) -> None:
+        self.build = build
+        self._sql: dict[str, tuple[str, list[Any], dict[str, Any]]] = {}
+
+    def __call__(self, **values: int | dt.datetime) -> list[tuple[Any, ...]]:
+        if connection.vendor != "postgresql":
+            # Elsewhere (SQLite) parameters are adapted as text at compile time: the ORM runs it.
+            return [tuple(row) for row in self.build(**values)]
+        sql, template, stand_ins = self._compiled(values)
+        params = [_put_back(param, stand_ins, values) for param in template]
+        with connection.cursor() as cursor:
+            cursor.execute(sql, params)
+            return [tuple(row) for row in cursor.fetchall()]
+
+    def _compiled(self, values: dict[str, Any]) -> tuple[str, list[Any], dict[str, Any]]:
+        key = connection.alias
+        if key not in self._sql:
+            stand_ins = {
+                name: _stand_in(index, value)
+                for index, (name, value) in enumerate(sorted(values.items()))
+            }
+            sql, params = self.build(**stand_ins).query.sql_with_params()
+            self._sql[key] = (sql, list(params), stand_ins)
+        return self._sql[key]
+
+
+def compiled(build: Callable[..., QuerySet[Any, Any]]) -> Compiled:
+    """Compiled, as a decorator of the function that builds the query."""
+    return Compiled(build)
+
+
+def _stand_in(index: int, value: object) -> int | dt.datetime:
+    if isinstance(value, dt.datetime):
+        return _STAND_IN_EPOCH + index * _STAND_IN_SPACING
+    if isinstance(value, int) and not isinstance(value, bool):
+        return _FIRST_STAND_IN - index
+    raise TypeError(f"A compiled query takes ints and datetimes, not {value!r}.")
+
+
+def _put_back(param: Any, stand_ins: dict[str, Any], values: dict[str, Any]) -> Any:
+    for name, stand_in in stand_ins.items():
+        if isinstance(stand_in, dt.datetime) and isinstance(param, dt.datetime):
+            offset = param - stand_in
+            if abs(offset) < _STAND_IN_SPACING / 2:
+                return values[name] + offset
+        elif type(param) is int and param == stand_in:
+            return values[name]
+    return param

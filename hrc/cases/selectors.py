@@ -42,7 +42,7 @@ from hrc.cases.models import (
     Message,
     WorkItem,
 )
-from hrc.cases.nets import case_net
+from hrc.cases.nets import net_of
 from hrc.engine.petri import Marking
 from hrc.organisations.models import Team
 from hrc.organisations.selectors import AnyUser, organisations_of, writable_organisations
@@ -222,7 +222,7 @@ def why_held(cobot_id: int, *, other_than: int | None = None) -> str:
     if item is None:
         return ""
     case = item.case
-    net = case_net(case.version)
+    net = net_of(case)
     tasks = net.holding_for(item.task, Marking(case.marking)) or net.holding_for(item.task)
     labels = " and ".join(net.labels[task] for task in tasks) or item.label
     return f"holding for: {labels}, case {case.pk}"

@@ -96,6 +96,7 @@ def start_cases(
                 timer_scale=timer_scale,
             )  # fmt: skip
             case = progress.lock_case(case.pk)
+            case.version = version  # in hand: its callers read it
             record_event(case, EventType.CASE_STARTED, user=started_by, after=net.initial)
             progress.advance(case, net)
             case.save()

@@ -184,10 +184,11 @@ def _command_in_flight(cobot: Cobot) -> str:
     )
 
 
-def running_commands() -> QuerySet[CobotCommand]:
-    """The commands sent and not yet answered, leaving out those lost with their process."""
+def running_commands(now: dt.datetime | None = None) -> QuerySet[CobotCommand]:
+    """The commands sent and not yet answered by `now` (default: now), leaving out those lost
+    with their process."""
     return CobotCommand.objects.filter(
-        outcome=CommandOutcome.RUNNING, requested_at__gte=timezone.now() - STALE_AFTER
+        outcome=CommandOutcome.RUNNING, requested_at__gte=(now or timezone.now()) - STALE_AFTER
     )
 
 

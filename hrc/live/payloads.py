@@ -17,6 +17,7 @@ from django.contrib.auth.models import User
 
 from hrc.cases.choices import JobState
 from hrc.cases.models import Case, WorkItem
+from hrc.cases.nets import compiled_net
 from hrc.cobots.models import CellStop
 from hrc.live.events import (
     CaseData,
@@ -113,7 +114,10 @@ def case_row(case: Case) -> CaseRow:
 
 
 def _case_name(case: Case) -> str:
-    # Only when the version is loaded already (lock_case reads it along): never a query here.
+    # Only from what is in hand (the compiled net, or a version read along): never a query.
+    net = compiled_net(case.version_id)
+    if net is not None:
+        return net.pattern.name
     if not Case.version.is_cached(case):
         return ""
     return str((case.version.document or {}).get("name") or "")

@@ -62,7 +62,9 @@ def interruption(
 ) -> Interruption:
     version = factories.make_version(organisation, published_by=engineer)
     case = factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
-    item = factories.open_work_item(case, "tc1")
+    item = factories.open_work_item(case, "tc1")  # leased as the cobot was free
+    # Another case's step waits in the queue behind it.
+    factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
     return Interruption.objects.create(
         case=case, work_item=item, by_work_item=item, cobot=cobot,
         mode=InterruptionMode.PAUSE,

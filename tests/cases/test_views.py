@@ -310,11 +310,17 @@ def test_interruptions_are_listed_with_their_durations(
     assert cobot.name in section
 
 
-def test_the_open_tasks_say_where_a_cobot_job_stands(engineer: User, step_case: Case) -> None:
-    page = _client(engineer).get(f"/cases/{step_case.pk}/").content.decode()
-    section = page[page.index('id="work-items"') : page.index('id="case-data"')]
-    assert "place insert" in section
-    assert "queued, position 1" in section
+def test_the_open_tasks_say_where_a_cobot_job_stands(
+    engineer: User, operator: User, cobot: Cobot, step_case: Case
+) -> None:
+    behind = factories.hand_over_case(
+        step_case.version, started_by=engineer, operator=operator, cobot=cobot
+    )  # its step waits for step_case's, which the cobot was free to take
+    for case, where in ((step_case, "running"), (behind, "queued, position 1")):
+        page = _client(engineer).get(f"/cases/{case.pk}/").content.decode()
+        section = page[page.index('id="work-items"') : page.index('id="case-data"')]
+        assert "place insert" in section
+        assert where in section
 
 
 # Open incidents ----------------------------------------------------------------------------

@@ -100,7 +100,8 @@ def _waiting_for(cobot: Cobot, reason: str) -> float:
 @pytest.fixture
 def queued(organisation: Organisation, engineer: User, operator: User, cobot: Cobot) -> Cobot:
     version = factories.make_version(organisation, published_by=engineer)
-    factories.hand_over_case(version, started_by=operator, operator=operator, cobot=cobot)
+    for _ in range(2):  # the first one's step takes the free cobot, the second one's waits
+        factories.hand_over_case(version, started_by=operator, operator=operator, cobot=cobot)
     return cobot
 
 

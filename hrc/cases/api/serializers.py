@@ -26,7 +26,7 @@ from hrc.cases.choices import (
 )
 from hrc.cases.messages import DEFAULT_TTL_SECONDS, MAX_TTL_SECONDS
 from hrc.cases.models import Case, CaseEvent, Incident, Interruption, Job, Message, WorkItem
-from hrc.cases.nets import case_net
+from hrc.cases.nets import net_of
 from hrc.organisations.api.serializers import MemberOrganisationField
 from hrc.patterns.models import PatternVersion
 from hrc.patterns.selectors import versions_visible_to
@@ -196,7 +196,7 @@ class WorkItemDetailSerializer(WorkItemSerializer):
 
     @extend_schema_field(OpenApiTypes.OBJECT)
     def get_form(self, item: WorkItem) -> dict[str, Any] | None:
-        config = case_net(item.case.version).tasks.get(item.task)
+        config = net_of(item.case).tasks.get(item.task)
         return dict(config.form) if config is not None and config.form is not None else None
 
 

@@ -115,11 +115,15 @@ def test_a_running_case_has_open_bars_a_waiting_task_and_no_arrow_yet(
     operator: User,
     cobot: Cobot,
 ) -> None:
-    case = make_case(
-        hand_over,
-        started_by=engineer,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+    ahead, case = (
+        make_case(
+            hand_over,
+            started_by=engineer,
+            actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+        )
+        for _ in range(2)
     )
+    operator_does(ahead, "to1", operator)  # its step takes the free cobot
     operator_does(case, "to1", operator)  # the step is queued: its task is offered, not started
     body = gantt(engineer_client, case.pk)
     assert body["open"] is True

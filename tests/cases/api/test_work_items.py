@@ -378,13 +378,14 @@ def test_cobot_tasks_are_listed_read_only_with_their_job_and_queue_position(
     response = operator_client.get("/api/work-items/?kind=step,device")
     assert response.status_code == 200
     rows = response.data["results"]
+    # The first completion leased its step for the free cobot; the second one's waits.
     assert [(r["case"], r["task"], r["kind"], r["state"]) for r in rows] == [
-        (first.pk, "tc1", "step", "offered"),
+        (first.pk, "tc1", "step", "running"),
         (second.pk, "tc1", "step", "offered"),
     ]
     assert [
         (r["job"]["state"], r["job"]["queue_position"], r["job"]["cobot_name"]) for r in rows
-    ] == [("queued", 1, "ur5e-left"), ("queued", 2, "ur5e-left")]
+    ] == [("running", 0, "ur5e-left"), ("queued", 1, "ur5e-left")]
     assert _tasks(operator_client) == []  # the operator's own list has no cobot task
     item = WorkItem.objects.get(pk=rows[0]["id"])
     refused = _act(operator_client, item, "start")

@@ -1,0 +1,207 @@
+"""The hot path: an operator's completion hands the step it enables to a free cobot in its own
+transaction, a worker claims that lease in one statement, and each transaction runs a fixed
+number of statements (counted here, so that a change cannot add one silently)."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import pytest
+from django.contrib.auth.models import User
+from django.db import connection, connections, transaction
+from django.utils import timezone
+
+from hrc.cases import dispatch, jobs, progress, services
+from hrc.cases.choices import CaseStatus, JobState, WorkItemState
+from hrc.cases.dispatch import Task
+from hrc.cases.models import Case, Job, WorkItem
+from hrc.cobots.models import Cobot
+from hrc.organisations.models import Organisation
+from hrc.patterns.models import PatternVersion
+from tests import factories
+
+pytestmark = pytest.mark.django_db(transaction=True)
+
+
+class Statements:
+    """The SQL statements this connection sends (BEGIN and COMMIT are not among them)."""
+
+    def __init__(self) -> None:
+        self.sent: list[str] = []
+
+    def __call__(self, execute: Callable[..., Any], sql: str, *args: Any) -> Any:
+        self.sent.append(sql)
+        return execute(sql, *args)
+
+
+@contextmanager
+def counted() -> Iterator[Statements]:
+    statements = Statements()
+    with connection.execute_wrapper(statements):
+        yield statements
+
+
+@contextmanager
+def sent_tasks() -> Iterator[list[tuple[Task, tuple[Any, ...]]]]:
+    """The Celery tasks sent after commit, kept instead of sent."""
+    kept: list[tuple[Task, tuple[Any, ...]]] = []
+    original = dispatch._send
+
+    def keep(task: Task, args: tuple[Any, ...], countdown: float) -> None:
+        kept.append((task, args))
+
+    dispatch._send = keep
+    try:
+        yield kept
+    finally:
+        dispatch._send = original
+
+
+@pytest.fixture
+def version(organisation: Organisation, engineer: User) -> PatternVersion:
+    return factories.make_version(organisation, published_by=engineer)
+
+
+def _started(version: PatternVersion, engineer: User, operator: User, cobot: Cobot) -> WorkItem:
+    """The operator task of a new hand-over case, started: its completion enables the step."""
+    case = factories.make_case(
+        version, started_by=engineer,
+        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
+    )  # fmt: skip
+    item = factories.open_work_item(case, "to1")
+    services.start_work_item(item, user=operator)
+    return item
+
+
+def _job(item: WorkItem) -> Job:
+    return Job.objects.select_related("cobot").get(case_id=item.case_id)
+
+
+def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a_doorbell(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks() as sent, counted() as statements:
+        services.complete_work_item(item, user=operator)
+    job = _job(item)
+    assert (job.state, job.lease, job.held_by) == (JobState.RUNNING, 1, "")
+    assert WorkItem.objects.get(pk=job.work_item_id).state == WorkItemState.RUNNING
+    [(task, (message,))] = sent
+    assert task == Task.RUN_LEASED_JOB
+    assert (message["job"], message["lease"], message["cobot"]["name"]) == (job.pk, 1, cobot.name)
+    assert message["command"] == job.command
+    # The lock, the item, the step's offer and job, the cobot, its start and lease, then the
+    # log and the case in one statement.
+    assert len(statements.sent) == 11, statements.sent
+
+
+@pytest.mark.parametrize("busy", ["queued", "stopped", "locked by a worker"])
+def test_a_completion_queues_the_step_when_its_cobot_is_not_free(
+    busy: str, version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    ahead = _started(version, engineer, operator, cobot)
+    item = _started(version, engineer, operator, cobot)
+    if busy == "queued":
+        services.complete_work_item(ahead, user=operator)  # its step leased: the cobot has work
+    elif busy == "stopped":
+        Cobot.objects.filter(pk=cobot.pk).update(stopped_at=timezone.now())
+    with _cobot_locked(cobot.pk if busy == "locked by a worker" else None), sent_tasks() as sent:
+        services.complete_work_item(item, user=operator)
+    job = _job(item)
+    assert (job.state, job.lease) == (JobState.QUEUED, 0)
+    assert WorkItem.objects.get(pk=job.work_item_id).state == WorkItemState.OFFERED
+    assert sent == [(Task.RUN_JOB, (job.pk,))]  # its doorbell, as before
+
+
+@contextmanager
+def _cobot_locked(cobot_id: int | None) -> Iterator[None]:
+    """The cobot's row locked by another session (a worker leasing) while the block runs."""
+    if cobot_id is None:
+        yield
+        return
+    locked, release = threading.Event(), threading.Event()
+
+    def hold() -> None:
+        try:
+            with transaction.atomic():
+                Cobot.objects.select_for_update(no_key=True).get(pk=cobot_id)
+                locked.set()
+                release.wait(30)
+        finally:
+            connections.close_all()
+
+    holder = threading.Thread(target=hold)
+    holder.start()
+    assert locked.wait(10)
+    try:
+        yield  # SKIP LOCKED: the completion does not wait for the worker
+    finally:
+        release.set()
+        holder.join(10)
+
+
+def test_a_worker_claims_a_leased_step_once_in_one_statement(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks() as sent:
+        services.complete_work_item(item, user=operator)
+    [(_, (message,))] = sent
+    lease = jobs.Lease.from_message(message)
+    with counted() as statements:
+        assert jobs._claim(lease)
+    assert len(statements.sent) == 1
+    assert _job(item).held_by == progress.worker_name()
+    assert not jobs._claim(lease)  # a duplicate of the message (the sweeper's) does nothing
+
+
+def test_the_sweeper_sends_an_unclaimed_lease_again(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot, settings: Any
+) -> None:
+    settings.HRC_SWEEP_SECONDS = 0.0
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks() as lost:
+        services.complete_work_item(item, user=operator)
+    with sent_tasks() as sent:
+        assert jobs.sweep()["unclaimed"] == 1
+    [(message,)] = [args for task, args in sent if task == Task.RUN_LEASED_JOB]
+    assert (message["job"], message["lease"]) == (lost[0][1][0]["job"], 1)
+    assert jobs._claim(jobs.Lease.from_message(message))
+    with sent_tasks():
+        assert jobs.sweep()["unclaimed"] == 0  # claimed: nothing to send
+
+
+def test_the_finish_runs_a_fixed_number_of_statements(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks() as sent:
+        services.complete_work_item(item, user=operator)
+    lease = jobs.Lease.from_message(sent[0][1][0])
+    assert jobs._claim(lease)
+    with sent_tasks(), counted() as statements:
+        jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0})
+    assert Case.objects.get(pk=item.case_id).status == CaseStatus.COMPLETED
+    # The case's lock, the job and its item, their updates, the open items, the log and the
+    # case in one statement; after the commit, whether the cobot has a job queued.
+    assert len(statements.sent) == 7, statements.sent
+
+
+def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=timezone.now())
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks():
+        services.complete_work_item(item, user=operator)  # queued: the cell is stopped
+    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=None)
+    with counted() as statements:
+        lease = jobs._lease_next("id = %s", cobot.pk)  # what a doorbell runs (run_next_job)
+    assert lease is not None
+    assert lease.job_id == _job(item).pk
+    # The cobot's lock, its queue, the case's lock, the job and its item, the step's start,
+    # the open items, the lease, the log and the case in one statement.
+    assert len(statements.sent) == 8, statements.sent
