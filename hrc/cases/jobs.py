@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -124,7 +125,21 @@ def run_next_job(job_id: int) -> None:
 
 
 def _drive(take: Callable[[], Lease | None]) -> None:
-    """Drives the job `take` leases, if any, and records how it ended."""
+    """Drives the job `take` leases, if any, and records how it ended; then leases the cobot's
+    next job itself, as the cobot is free now (no doorbell: progress.hand_over leaves a step
+    queued behind a running one to this). That job is driven here too while this task is
+    younger than HRC_CHAIN_SECONDS, else handed to the workers, so that a worker serving a
+    busy cobot lets the other cobots' doorbells have their turn."""
+    began = time.monotonic()
+    lease = take()
+    while lease is not None:
+        _run(lease)
+        young = time.monotonic() - began < settings.HRC_CHAIN_SECONDS
+        lease = _lease_next("id = %s", lease.cobot.pk, hand_over=not young)
+
+
+def _run(lease: Lease) -> None:
+    """Drives one leased job and records how it ended."""
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
     # started, the queue) waits until the cobot has accepted the step (events.hold_publishing).
     hold = events.hold_publishing()
@@ -136,24 +151,21 @@ def _drive(take: Callable[[], Lease | None]) -> None:
         hold.release()
 
     try:
-        lease = take()
-        if lease is None:
-            return
-        try:
-            result = _execute(lease, on_sent=on_sent)
-        except DriverError as error:
-            fail_job(lease, error, accepted_at=accepted[0] if accepted else None)
-        except Exception as error:
-            # A fault of ours, not the cobot's answer: the step's outcome is unknown, so it is
-            # never sent again by itself (a person retries, with the step's token).
-            logger.exception("Job %s failed unexpectedly", lease.job_id)
-            message = (
-                f"hrc failed while running the step ({error!r}); it is not sent again by itself. "
-                "See the workers' log, check the cobot, then retry or skip."
-            )
-            fail_job(lease, DriverError(message), accepted_at=accepted[0] if accepted else None)
-        else:
-            finish_job(lease, result, accepted_at=accepted[0] if accepted else None)
+        result = _execute(lease, on_sent=on_sent)
+    except DriverError as error:
+        fail_job(lease, error, accepted_at=accepted[0] if accepted else None)
+    except Exception as error:
+        # A fault of ours, not the cobot's answer: the step's outcome is unknown, so it is
+        # never sent again by itself (a person retries, with the step's token).
+        logger.exception("Job %s failed unexpectedly", lease.job_id)
+        message = (
+            f"hrc failed while running the step ({error!r}); it is not sent again by itself. "
+            "See the workers' log, check the cobot, then retry or skip."
+        )
+        fail_job(lease, DriverError(message), accepted_at=accepted[0] if accepted else None)
+    else:
+        # No doorbell for the cobot's next job: _drive leases it next.
+        finish_job(lease, result, accepted_at=accepted[0] if accepted else None, ring=False)
     finally:
         hold.release()
 
@@ -173,9 +185,10 @@ def lease_next_job(cobot_id: int) -> Lease | None:
     return _lease_next("id = %s", cobot_id)
 
 
-def _lease_next(which: str, key: int) -> Lease | None:
+def _lease_next(which: str, key: int, *, hand_over: bool = False) -> Lease | None:
     """`lease_next_job` for the cobot `which` selects (SQL over the cobot's columns, `key` its
-    parameter: the cobot's own id, or one of its jobs')."""
+    parameter: the cobot's own id, or one of its jobs'). `hand_over`: the lease is taken for
+    the workers, its message sent once it commits (jobs.run_leased_job), and None returned."""
     now = timezone.now()
     with transaction.atomic():
         # The lock first, then the reasons to wait in a statement of their own: a statement
@@ -199,7 +212,9 @@ def _lease_next(which: str, key: int) -> Lease | None:
         for job_id, case_id, busy, paused, held, commanded, speed_due in queued:
             if busy or paused or commanded:
                 return None
-            lease = _lease_if_ready(cobot, job_id, case_id, now, held=held, speed_due=speed_due)
+            lease = _lease_if_ready(
+                cobot, job_id, case_id, now, held=held, speed_due=speed_due, hand_over=hand_over
+            )
             if lease is not None:
                 return lease
     return None
@@ -231,10 +246,18 @@ def _held_by_another_case(cobot_id: int | OuterRef) -> QuerySet[WorkItem]:
 
 
 def _lease_if_ready(
-    cobot: Cobot, job_id: int, case_id: int, now: dt.datetime, *, held: bool, speed_due: bool
+    cobot: Cobot,
+    job_id: int,
+    case_id: int,
+    now: dt.datetime,
+    *,
+    held: bool,
+    speed_due: bool,
+    hand_over: bool,
 ) -> Lease | None:
     """Leases the job when it may start now, else records why it waits; `held` and `speed_due`
-    are the queue statement's (_queue; a hold is asked again here)."""
+    are the queue statement's (_queue; a hold is asked again here); `hand_over` as in
+    _lease_next."""
     case, job = lock_case_and_job(case_id, job_id)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
@@ -251,14 +274,18 @@ def _lease_if_ready(
         if record_waiting(job, waiting):
             events.publish_cobot_queue(cobot.pk)
         return None
-    progress.lease_job(case, net, job, now, held_by=progress.worker_name())
+    progress.lease_job(case, net, job, now, held_by="" if hand_over else progress.worker_name())
     case.save()
     events.publish_cobot_queue(cobot.pk)
+    speed_due = speed_due or item.task in net.space_tasks  # a start beside an operator slows it
+    if hand_over:
+        fields = {field: getattr(cobot, field) for field in progress.COBOT_FIELDS}
+        message = progress.leased_message(job, {**fields, "speed_due": speed_due})
+        dispatch.send_on_commit(Task.RUN_LEASED_JOB, message)
+        return None
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
-        sent_before=job.sent_at is not None,
-        # Starting a space constraint's task may have slowed it for an operator just now.
-        speed_due=speed_due or item.task in net.space_tasks,
+        sent_before=job.sent_at is not None, speed_due=speed_due,
     )  # fmt: skip
 
 
@@ -396,12 +423,17 @@ def _mark_sent(lease: Lease) -> bool:
 
 
 def finish_job(
-    lease: Lease, result: dict[str, Any], *, accepted_at: dt.datetime | None = None
+    lease: Lease,
+    result: dict[str, Any],
+    *,
+    accepted_at: dt.datetime | None = None,
+    ring: bool = True,
 ) -> None:
     """Records a job's success and completes its task (now, or once func constraints allow).
 
     `accepted_at`: when the cobot accepted the step (the driver's on_sent); the lease's
-    start when not given."""
+    start when not given. `ring`: the doorbell of the job's queue rings after the commit (a
+    worker that leases the cobot's next job itself says no)."""
     with transaction.atomic():
         case, job = _locked_job(lease)
         if job is None:
@@ -416,7 +448,8 @@ def finish_job(
         elif case.status in OPEN_CASE_STATUSES:
             progress.complete_cobot_task(case, net_of(case), job.work_item, result)
         case.save()
-        _ring_for_next_on_commit(job)
+        if ring:
+            _ring_for_next_on_commit(job)
 
 
 def _ring_for_next_on_commit(job: Job) -> None:

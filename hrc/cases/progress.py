@@ -300,14 +300,25 @@ def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> 
     rows.insert(job)
     jobs_queued_now(case).append(job)
     # The queue's doorbell, unless hand_over leased the job in this transaction (its message
-    # goes to a worker instead): asked of the row in hand, after the commit.
-    dispatch.send_on_commit_if(lambda: job.state == JobState.QUEUED, Task.RUN_JOB, job.pk)
+    # goes to a worker instead) or saw a step running on the cobot (its worker leases the
+    # next job once it is done: jobs._drive): asked of the rows in hand, after the commit.
+    dispatch.send_on_commit_if(
+        lambda: job.state == JobState.QUEUED and job.pk not in _behind_a_step(case),
+        Task.RUN_JOB, job.pk,
+    )  # fmt: skip
 
 
 def jobs_queued_now(case: Case) -> list[Job]:
     """The jobs this transaction queued for the case, in order (hand_over's candidates)."""
     queued: list[Job] = case.__dict__.setdefault("_jobs_queued_now", [])
     return queued
+
+
+def _behind_a_step(case: Case) -> set[int]:
+    """The jobs this transaction queued behind a step it saw running on their cobot while it
+    held the cobot's row (hand_over): that step's worker leases them, no doorbell needed."""
+    behind: set[int] = case.__dict__.setdefault("_behind_a_step", set())
+    return behind
 
 
 def _withdraw(case: Case, item: WorkItem, why: str) -> None:
@@ -479,6 +490,12 @@ def hand_over(case: Case, net: CaseNet) -> None:
         cobot = _take_free_cobot(job)
         if cobot is None:
             continue
+        if cobot["running"]:
+            # Its worker leases the next job after its commit, taking this row's lock first,
+            # so it sees this job: the worker's lease is the doorbell (jobs._drive).
+            _behind_a_step(case).add(job.pk)
+        if not cobot["free"]:
+            continue
         lease_job(case, net, job, now, held_by="")
         dispatch.send_on_commit(Task.RUN_LEASED_JOB, leased_message(job, cobot))
         marking = Marking(case.marking)
@@ -489,28 +506,41 @@ COBOT_FIELDS = ("id", "organisation_id", "name", "endpoint", "credentials_source
 
 
 def _take_free_cobot(job: Job) -> dict[str, Any] | None:
-    """Locks the job's cobot (SKIP LOCKED) when it is free for the job (hand_over): its
-    COBOT_FIELDS, and `speed_due`, whether a speed change waits to be sent before its next
-    step; None when it is not free."""
+    """Locks the job's cobot's row (SKIP LOCKED): its COBOT_FIELDS; `free`, whether it may take
+    the job now; `running`, whether a step runs on it; `speed_due`, whether a speed change
+    waits to be sent before its next step. None when another session holds the row."""
     assert job.cobot_id is not None  # a step's job is on a cobot
-    found = _free_cobot(cobot=job.cobot_id, job=job.pk, case=job.case_id, now=timezone.now())
-    return dict(zip((*COBOT_FIELDS, "speed_due"), found[0], strict=True)) if found else None
+    found = _cobot_for(cobot=job.cobot_id, job=job.pk, case=job.case_id, now=timezone.now())
+    if not found:
+        return None
+    row = found[0]
+    stopped_at, running, ahead, paused, held, commanded, speed_due = row[len(COBOT_FIELDS) :]
+    return dict(zip(COBOT_FIELDS, row, strict=False)) | {
+        "free": not (stopped_at or running or ahead or paused or held or commanded),
+        "running": running, "speed_due": speed_due,
+    }  # fmt: skip
 
 
 @rows.compiled
-def _free_cobot(cobot: int, job: int, case: int, now: dt.datetime) -> QuerySet[Cobot, Any]:
+def _cobot_for(cobot: int, job: int, case: int, now: dt.datetime) -> QuerySet[Cobot, Any]:
     here = OuterRef("pk")
-    others = Job.objects.filter(cobot=here, state__in=[JobState.QUEUED, JobState.RUNNING])
+    others = Job.objects.filter(cobot=here).exclude(pk=job)
     return (
         Cobot.objects.select_for_update(of=("self",), no_key=True, skip_locked=True)
-        .filter(pk=cobot, stopped_at__isnull=True)
-        .exclude(Exists(others.exclude(pk=job)))
-        .exclude(Exists(unsettled_pauses(here)))
-        .exclude(Exists(holding_work_items().filter(cobot_id=here).exclude(case_id=case)))
-        .exclude(Exists(running_commands(now).filter(cobot=here)))
-        .annotate(speed_due=Exists(speed_changes_due(here)))
-        .values_list(*COBOT_FIELDS, "speed_due")
-    )
+        .filter(pk=cobot)
+        .annotate(
+            running=Exists(others.filter(state=JobState.RUNNING)),
+            ahead=Exists(others.filter(state=JobState.QUEUED)),
+            paused=Exists(unsettled_pauses(here)),
+            held=Exists(holding_work_items().filter(cobot_id=here).exclude(case_id=case)),
+            commanded=Exists(running_commands(now).filter(cobot=here)),
+            speed_due=Exists(speed_changes_due(here)),
+        )
+        .values_list(
+            *COBOT_FIELDS, "stopped_at", "running", "ahead", "paused", "held", "commanded",
+            "speed_due",
+        )
+    )  # fmt: skip
 
 
 def leased_message(job: Job, cobot: Mapping[str, Any]) -> dict[str, Any]:
@@ -518,7 +548,8 @@ def leased_message(job: Job, cobot: Mapping[str, Any]) -> dict[str, Any]:
     the command, and the cobot's COBOT_FIELDS and `speed_due` (jobs.Lease.from_message)."""
     return {
         "job": job.pk, "case": job.case_id, "lease": job.lease, "attempt": job.attempt,
-        "kind": job.kind, "command": job.command, "timeout": job.timeout, "cobot": dict(cobot),
+        "kind": job.kind, "command": job.command, "timeout": job.timeout,
+        "cobot": {field: cobot[field] for field in (*COBOT_FIELDS, "speed_due")},
     }  # fmt: skip
 
 

@@ -285,6 +285,9 @@ HRC_JOB_LEASE_MARGIN = float(env_str("HRC_JOB_LEASE_MARGIN") or 30.0)
 HRC_RETRY_BACKOFF = float(env_str("HRC_RETRY_BACKOFF") or 1.0)
 # How far down a cobot's queue a free cobot looks for a job whose task may start.
 HRC_QUEUE_LOOKAHEAD = 20
+# A worker that finishes a step drives its cobot's next one itself while its task is younger
+# than this, then hands the next one to the workers (the other cobots' doorbells get a turn).
+HRC_CHAIN_SECONDS = float(env_str("HRC_CHAIN_SECONDS") or 0.5)
 # Without a broker (the embedded demo), jobs run on a thread pool in the web process.
 HRC_INLINE_TASKS = not REDIS_URL
 

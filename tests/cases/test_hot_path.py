@@ -113,7 +113,11 @@ def test_a_completion_queues_the_step_when_its_cobot_is_not_free(
     job = _job(item)
     assert (job.state, job.lease) == (JobState.QUEUED, 0)
     assert WorkItem.objects.get(pk=job.work_item_id).state == WorkItemState.OFFERED
-    assert sent == [(Task.RUN_JOB, (job.pk,))]  # its doorbell, as before
+    if busy == "queued":
+        # Behind a step it saw running: that step's worker leases it next (jobs._drive).
+        assert sent == []
+    else:
+        assert sent == [(Task.RUN_JOB, (job.pk,))]  # its doorbell, as before
 
 
 @contextmanager
@@ -205,3 +209,22 @@ def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
     # The cobot's lock, its queue, the case's lock, the job and its item, the step's start,
     # the open items, the lease, the log and the case in one statement.
     assert len(statements.sent) == 8, statements.sent
+
+
+def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_hand_it_over(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    first = _started(version, engineer, operator, cobot)
+    second = _started(version, engineer, operator, cobot)
+    with sent_tasks() as sent:
+        services.complete_work_item(first, user=operator)
+        services.complete_work_item(second, user=operator)  # queued behind the first
+    lease = jobs.Lease.from_message(sent[0][1][0])
+    assert jobs._claim(lease)
+    with sent_tasks() as rung:
+        jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0}, ring=False)
+        assert jobs._lease_next("id = %s", cobot.pk, hand_over=True) is None
+    job = _job(second)
+    assert (job.state, job.lease, job.held_by) == (JobState.RUNNING, 1, "")
+    [(task, (message,))] = rung
+    assert (task, message["job"], message["lease"]) == (Task.RUN_LEASED_JOB, job.pk, 1)
