@@ -136,6 +136,8 @@ def _drive(take: Callable[[], Lease | None]) -> None:
         _run(lease)
         young = time.monotonic() - began < settings.HRC_CHAIN_SECONDS
         lease = _lease_next("id = %s", lease.cobot.pk, hand_over=not young)
+        if not young:
+            return  # the next job, if any, went to the workers with its lease
 
 
 def _run(lease: Lease) -> None:
@@ -188,7 +190,7 @@ def lease_next_job(cobot_id: int) -> Lease | None:
 def _lease_next(which: str, key: int, *, hand_over: bool = False) -> Lease | None:
     """`lease_next_job` for the cobot `which` selects (SQL over the cobot's columns, `key` its
     parameter: the cobot's own id, or one of its jobs'). `hand_over`: the lease is taken for
-    the workers, its message sent once it commits (jobs.run_leased_job), and None returned."""
+    the workers, its message sent once it commits (run_leased_job): not this caller's to drive."""
     now = timezone.now()
     with transaction.atomic():
         # The lock first, then the reasons to wait in a statement of their own: a statement
@@ -282,7 +284,6 @@ def _lease_if_ready(
         fields = {field: getattr(cobot, field) for field in progress.COBOT_FIELDS}
         message = progress.leased_message(job, {**fields, "speed_due": speed_due})
         dispatch.send_on_commit(Task.RUN_LEASED_JOB, message)
-        return None
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
         sent_before=job.sent_at is not None, speed_due=speed_due,

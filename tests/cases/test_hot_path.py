@@ -223,8 +223,26 @@ def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_
     assert jobs._claim(lease)
     with sent_tasks() as rung:
         jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0}, ring=False)
-        assert jobs._lease_next("id = %s", cobot.pk, hand_over=True) is None
+        handed = jobs._lease_next("id = %s", cobot.pk, hand_over=True)
     job = _job(second)
+    assert handed is not None
+    assert handed.job_id == job.pk
     assert (job.state, job.lease, job.held_by) == (JobState.RUNNING, 1, "")
     [(task, (message,))] = rung
     assert (task, message["job"], message["lease"]) == (Task.RUN_LEASED_JOB, job.pk, 1)
+
+
+def test_a_lease_handed_to_the_workers_is_the_cobots_only_one(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    """The lease that hands the next job over ends the lease: the cobot has a job running."""
+    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=timezone.now())
+    items = [_started(version, engineer, operator, cobot) for _ in range(3)]
+    with sent_tasks():
+        for item in items:
+            services.complete_work_item(item, user=operator)  # queued: the cell is stopped
+    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=None)
+    with sent_tasks() as rung:
+        jobs._lease_next("id = %s", cobot.pk, hand_over=True)
+    assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
+    assert [task for task, _ in rung] == [Task.RUN_LEASED_JOB]
