@@ -3,7 +3,8 @@
 Use hrc.live.groups. One daemon thread per process drains the queue and does
 the group_send, so its Redis round trips never delay the step that caused
 them; it reads the cobot queues that changed once per batch, and a cobot's
-at most once per QUEUE_COALESCE_SECONDS (QueueReads). What one batch
+at most once per QUEUE_COALESCE_SECONDS (QueueReads). Under load a batch goes
+at most every BATCH_SECONDS, gathering what comes meanwhile. What one batch
 holds for the same groups goes in one channel message, encoded once: 200
 tablets cost 200 frames per commit, not 200 encodings per delta.
 
@@ -47,6 +48,10 @@ HOLD_LIMIT = 0.2
 # A cobot's queue is read and sent at most once in this many seconds per process: a lease and
 # its finish, close together, cost one read (the tablets see the queue this much later at most).
 QUEUE_COALESCE_SECONDS = 0.05
+# Under load, batches go at most this often per process: what arrives meanwhile joins the
+# next one, so a busy worker pays one channel send per batch, not one per step. A sender that
+# sent nothing for this long sends at once.
+BATCH_SECONDS = 0.025
 
 
 @dataclass
@@ -149,6 +154,7 @@ class Sender:
 
     def _run(self) -> None:
         loop = asyncio.new_event_loop()
+        sent_at = -BATCH_SECONDS
         while True:
             deferred = self.queue_reads.wait(time.monotonic())
             try:
@@ -160,12 +166,14 @@ class Sender:
                     continue
                 batch = []  # a deferred queue read is due
             self.open.wait(HOLD_LIMIT)
+            time.sleep(max(sent_at + BATCH_SECONDS - time.monotonic(), 0.0))
             while True:  # whatever else is waiting goes in the same batch
                 try:
                     batch.append(self.queue.get_nowait())
                 except queue.Empty:
                     break
             flushed = [work for work in batch if isinstance(work, _Flush)]
+            sent_at = time.monotonic()
             try:
                 self._send_batch(batch, loop, everything=bool(flushed))
             except Exception:
