@@ -441,7 +441,8 @@ def finish_job(
             return
         job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
         job.accepted_at = accepted_at or job.started_at
-        rows.update(job, ["state", "result", "ended_at", "accepted_at"])
+        # Written with the case: what the task's completion reads of jobs is other jobs'.
+        case.keep(job, ["state", "result", "ended_at", "accepted_at"])
         if job.work_item.state == WorkItemState.CANCELLED:
             events.record_event(
                 case, EventType.CANCELLED_STEP_ENDED, item=job.work_item, detail={"result": result}

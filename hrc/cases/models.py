@@ -11,9 +11,10 @@ the timeline. Writes go through hrc.cases.services only.
 from typing import Any
 
 from django.conf import settings
-from django.db import connections, models
+from django.db import models
 from django.db.models import Q
 
+from hrc.cases import rows
 from hrc.cases.choices import (
     OPEN_WORK_ITEM_STATES,
     CaseStatus,
@@ -77,27 +78,28 @@ class Case(models.Model):
         return f"case {self.pk} of {self.version}"
 
     def save(self, *args: Any, **kwargs: Any) -> None:
-        """Saves the case with the events logged since it was read: one statement on PostgreSQL
-        (the log and the case's changing columns, CHANGING_FIELDS unless update_fields says)."""
+        """Saves the case with the events logged and the rows kept for it since it was read, in
+        one statement (the case's CHANGING_FIELDS unless update_fields says)."""
         events: list[CaseEvent] = self.__dict__.pop("_unwritten_events", [])
-        using = kwargs.get("using") or "default"
-        if (
-            events
-            and connections[using].vendor == "postgresql"
-            and not self._state.adding
-            and not args
-            and set(kwargs) <= {"update_fields", "using"}
-        ):
-            _save_with_events(self, events, kwargs.get("update_fields"), using)
+        rows_kept: list[tuple[models.Model, list[str]]] = self.__dict__.pop("_unwritten_rows", [])
+        if self._state.adding or args or not set(kwargs) <= {"update_fields"}:
+            for row, changed in rows_kept:
+                rows.update(row, changed)
+            super().save(*args, **kwargs)
+            CaseEvent.objects.bulk_create(events)
             return
-        super().save(*args, **kwargs)
-        if events:
-            CaseEvent.objects.using(using).bulk_create(events)
+        fields = kwargs.get("update_fields") or CHANGING_FIELDS
+        rows.save_with(self, fields, inserts=events, updates=rows_kept)
 
     def log(self, event: "CaseEvent") -> None:
         """Keeps an event of this case for the next save(), which writes it (events.record_event):
         a transaction writes its case's events and the case in one statement, not one each."""
         self.__dict__.setdefault("_unwritten_events", []).append(event)
+
+    def keep(self, row: models.Model, fields: list[str]) -> None:
+        """Keeps these fields of a row of this case (its job, say) for the next save(), which
+        writes them with the case. Only for a row nothing reads before the case is saved."""
+        self.__dict__.setdefault("_unwritten_rows", []).append((row, fields))
 
 
 # The columns of a case that change after its start: what save() writes with its events.
@@ -364,33 +366,6 @@ class CaseEvent(models.Model):
         if not self._state.adding:
             raise ImmutableEventError(f"Event {self.seq} of case {self.case_id} cannot be changed.")
         super().save(*args, **kwargs)
-
-
-def _save_with_events(case: Case, events: list[CaseEvent], update_fields: Any, using: str) -> None:
-    """INSERT the events and UPDATE the case in one statement (a data-modifying WITH)."""
-    connection = connections[using]
-    quote = connection.ops.quote_name
-    logged = [field for field in CaseEvent._meta.concrete_fields if not field.primary_key]
-    names = set(update_fields or CHANGING_FIELDS)
-    changed = [field for field in Case._meta.concrete_fields if field.name in names]
-    columns = {field: quote(field.column or field.attname) for field in [*logged, *changed]}
-    params = [
-        field.get_db_prep_save(getattr(row, field.attname), connection)
-        for row in events
-        for field in logged
-    ] + [field.get_db_prep_save(getattr(case, field.attname), connection) for field in changed]
-    row = f"({', '.join(['%s'] * len(logged))})"
-    sql = (
-        f"WITH logged AS (INSERT INTO {quote(CaseEvent._meta.db_table)} "
-        f"({', '.join(columns[field] for field in logged)}) "
-        f"VALUES {', '.join([row] * len(events))}) "
-        f"UPDATE {quote(Case._meta.db_table)} "
-        f"SET {', '.join(f'{columns[field]} = %s' for field in changed)} WHERE id = %s"
-    )
-    with connection.cursor() as cursor:
-        cursor.execute(sql, [*params, case.pk])
-    for event in events:
-        event._state.adding = False  # written: a later save() would change it, and is refused
 
 
 class Message(models.Model):

@@ -444,7 +444,8 @@ def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
 
 def lease_job(case: Case, net: CaseNet, job: Job, now: dt.datetime, *, held_by: str) -> None:
     """Leases the job (its next lease number), starting its task when it is only offered (the
-    cobot or device taking the job is the moment the task starts); saves the job, not the case.
+    cobot or device taking the job is the moment the task starts); the caller's case.save()
+    writes the job with the case.
     `held_by`: the worker's host:pid, or "" for a lease a worker is yet to claim (hand_over).
     Call holding the case's lock and the job's queue's, once nothing keeps the job waiting."""
     if job.work_item.state == WorkItemState.OFFERED:
@@ -453,7 +454,7 @@ def lease_job(case: Case, net: CaseNet, job: Job, now: dt.datetime, *, held_by: 
     job.held_by = held_by
     job.started_at = job.started_at or now
     job.lease_expires_at = now + dt.timedelta(seconds=job.timeout + settings.HRC_JOB_LEASE_MARGIN)
-    rows.update(job, LEASED_FIELDS)
+    case.keep(job, LEASED_FIELDS)  # nothing reads the job before the case is saved
 
 
 def worker_name() -> str:

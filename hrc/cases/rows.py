@@ -90,6 +90,46 @@ def update(instance: Model, fields: Sequence[str]) -> int:
         return int(cursor.rowcount)
 
 
+def save_with(
+    instance: Model,
+    fields: Sequence[str],
+    *,
+    inserts: Sequence[Model] = (),
+    updates: Sequence[tuple[Model, Sequence[str]]] = (),
+) -> None:
+    """UPDATE of the instance's `fields`, with the INSERT of new rows of one model (`inserts`,
+    whose primary keys are not read back) and the UPDATEs of other rows (`updates`), in one
+    statement: a WITH of data-modifying statements (PostgreSQL), else one statement each."""
+    if connection.vendor != "postgresql":
+        for row, changed in updates:
+            update(row, changed)
+        if inserts:
+            manager: Any = type(inserts[0])._default_manager
+            manager.bulk_create(inserts)
+        update(instance, fields)
+        return
+    parts: list[str] = []
+    params: list[Any] = []
+    if inserts:
+        sql, columns = _insert_sql(type(inserts[0]))
+        head = sql.split(" VALUES ", 1)[0]
+        values = f"({', '.join(['%s'] * len(columns))})"
+        parts.append(f"inserted AS ({head} VALUES {', '.join([values] * len(inserts))})")
+        for new in inserts:
+            params += [field.get_db_prep_save(field.pre_save(new, True), connection) for field in columns]  # fmt: skip
+    for index, (other, changed) in enumerate(updates):
+        sql, chosen = _update_sql(type(other), tuple(changed))
+        parts.append(f"updated_{index} AS ({sql})")
+        params += [field.get_db_prep_save(field.pre_save(other, False), connection) for field in chosen]  # fmt: skip
+        params.append(other.pk)
+    sql, chosen = _update_sql(type(instance), tuple(fields))
+    params += [field.get_db_prep_save(field.pre_save(instance, False), connection) for field in chosen]  # fmt: skip
+    with connection.cursor() as cursor:
+        cursor.execute(f"WITH {', '.join(parts)} {sql}" if parts else sql, [*params, instance.pk])
+    for new in inserts:
+        new._state.adding, new._state.db = False, connection.alias
+
+
 def insert(instance: Model) -> None:
     """INSERT of a new instance, as Model.save() would (defaults, auto_now_add); sets its pk."""
     model = type(instance)
