@@ -116,7 +116,7 @@ def _signal_one_step(bench: Rig, observer: Observer) -> tuple[float, float, floa
     """A case to its operator task's start, then the timed completion over HTTP.
 
     Returns ms from the request to the register seen, to the response, and to
-    the moment the worker began to lease the job.
+    the moment the job was leased (its started_at: by the completion when the cobot was free).
     """
     from hrc.cases import services
     from hrc.cases.models import Job, WorkItem
@@ -789,7 +789,7 @@ def print_table(report: Mapping[str, Any]) -> None:
     rows = [
         ("ours: request → register set", signalling["ours"], None),
         ("  of which: request → HTTP response", signalling["http_response"], None),
-        ("  of which: request → worker starts the lease", signalling["to_lease"], None),
+        ("  of which: request → the job leased", signalling["to_lease"], None),
         ("floor: raw asyncua write round trip", floors["opcua_write"], "opcua_write"),
         ("floor: raw write seen by the observer", floors["opcua_write_seen"], "opcua_write_seen"),
         ("floor: bare Celery apply_async → task runs", floors["celery_dispatch"], "celery_dispatch"),

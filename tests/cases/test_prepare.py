@@ -71,9 +71,8 @@ def test_a_program_paused_for_an_operator_in_a_shared_area_is_not_played_and_the
         jobs._prepare(driver, cobot.pk, PROGRAM, timeout=10)
     assert driver.state()["ProgramState"] == urua.PROGRAM_PAUSED  # not played over the operator
 
-    lease = jobs.lease_next_job(cobot.pk)
-    assert lease is None  # the queue waits for the interruption, so lease the job as it was
-    Job.objects.filter(pk=job.pk).update(state=JobState.RUNNING, lease=1)
+    # The completion leased the job for the workers (the cobot was free then).
+    assert (job.state, job.lease) == (JobState.RUNNING, 1)
     retries = job.retries_left
     jobs.fail_job(
         jobs.Lease(
@@ -84,6 +83,7 @@ def test_a_program_paused_for_an_operator_in_a_shared_area_is_not_played_and_the
     job.refresh_from_db()
     assert (job.state, job.retries_left) == (JobState.QUEUED, retries)  # waits, retries spared
     assert not Incident.objects.filter(case=case).exists()
+    assert jobs.lease_next_job(cobot.pk) is None  # the queue waits for the interruption
 
 
 def test_a_paused_program_of_a_running_cell_is_played_for_the_step(

@@ -46,11 +46,14 @@ def test_the_cases_app_answers_whether_a_cobot_is_in_use_and_its_queue(
     idle = factories.make_cobot(organisation)
     version = factories.make_version(organisation, published_by=engineer)
     case = factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
+    behind = factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
 
-    assert hooks.cobot_in_use(cobot.pk) == ""  # queued is not in use
-    assert hooks.queue_lengths([cobot.pk, idle.pk]) == {cobot.pk: 1, idle.pk: 0}
-    assert jobs.lease_next_job(cobot.pk) is not None
+    # The first case's step was leased as the cobot was free; the second one's is queued.
+    assert f"case {case.pk}" in hooks.cobot_in_use(cobot.pk)
+    assert f"case {behind.pk}" not in hooks.cobot_in_use(cobot.pk)  # queued is not in use
+    assert hooks.cobot_in_use(idle.pk) == ""
+    assert hooks.queue_lengths([cobot.pk, idle.pk]) == {cobot.pk: 2, idle.pk: 0}
+    assert jobs.lease_next_job(cobot.pk) is not None  # a worker claims the first one
 
     assert f"case {case.pk}" in hooks.cobot_in_use(cobot.pk)
-    assert hooks.cobot_in_use(idle.pk) == ""
-    assert hooks.queue_lengths([cobot.pk]) == {cobot.pk: 1}
+    assert hooks.queue_lengths([cobot.pk]) == {cobot.pk: 2}

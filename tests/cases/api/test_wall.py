@@ -58,7 +58,7 @@ class World:
 def world(organisation: Organisation, engineer: User, operator: User) -> World:
     cobot = factories.make_cobot(organisation)
     version = factories.make_version(organisation, published_by=engineer)
-    # Two cases: one with its operator task open, one with its cobot step queued.
+    # Cases: one with its operator task open, one whose cobot step failed, one whose runs.
     mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}}
     case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
     stepped = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
@@ -68,7 +68,9 @@ def world(organisation: Organisation, engineer: User, operator: User) -> World:
     client.post(f"/api/work-items/{first.pk}/start/")
     client.post(f"/api/work-items/{first.pk}/complete/")
     step = factories.open_work_item(stepped, "tc1")
-    incident = factories.make_incident(step)
+    incident = factories.make_incident(step)  # its step failed: a person decides
+    # A third case's step on the cobot (taken by the completion): the queues list it.
+    factories.hand_over_case(version, started_by=engineer, operator=operator, cobot=cobot)
     return World(
         version, case, factories.open_work_item(case, "to1"), step, step.job, incident, cobot
     )
@@ -159,11 +161,12 @@ def test_an_outsider_cannot_start_a_case_of_our_version(
     outsider_client: APIClient, world: World, outsider: User
 ) -> None:
     body = {"version": world.version.pk, "actor_mapping": {"o": {"users": [outsider.pk]}}}
+    cases = Case.objects.count()
     response = outsider_client.post("/api/cases/", body, format="json")
     # Nothing is looked up by the URL: the version in the body is simply unknown to them.
     assert response.status_code == 400
     assert "version" in response.data["fields"]
-    assert Case.objects.count() == 2
+    assert Case.objects.count() == cases
 
 
 def test_an_outsiders_message_never_reaches_our_cases(
