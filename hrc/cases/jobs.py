@@ -293,7 +293,8 @@ def _lease_if_ready(
 def lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
     """Both rows locked, in the project's lock order (case, then job); the work item read along."""
     case = progress.lock_case(case_id)
-    job = rows.fetch_one_with(Job, "work_item", f"{rows.table(Job)}.id = %s", [job_id], lock="FOR NO KEY UPDATE")  # fmt: skip
+    where = f"{rows.table(Job)}.id = %s"
+    job = rows.fetch_one_with(Job, "work_item", where, [job_id], lock="FOR NO KEY UPDATE")
     if job is None:
         raise Job.DoesNotExist(f"There is no job {job_id}.")
     return case, job
