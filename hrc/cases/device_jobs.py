@@ -49,7 +49,7 @@ def is_device_job(job_id: int) -> bool:
     return bool(_on_a_device(job=job_id))
 
 
-@rows.compiled
+@rows.Compiled
 def _on_a_device(job: int) -> QuerySet[Job, Any]:  # asked on every doorbell: compiled once
     return Job.objects.filter(pk=job, device__isnull=False).values_list("pk")
 

@@ -19,11 +19,11 @@ import datetime as dt
 from typing import Final
 
 from django.db import transaction
-from django.db.models import Q, QuerySet
+from django.db.models import Q
 from django.utils import timezone
 
-from hrc.cases import dispatch
-from hrc.cases.choices import COMMANDED_MODES, InterruptionMode, JobState
+from hrc.cases import dispatch, progress
+from hrc.cases.choices import COMMANDED_MODES, JobState
 from hrc.cases.dispatch import Task
 from hrc.cases.models import Interruption, Job
 from hrc.cobots.commands import outside_transaction
@@ -82,11 +82,8 @@ def set_speed_before_step(cobot_id: int) -> bool:
     """Gives the cobot the speed its next step runs at, before the step goes: full speed
     restored after the slowdowns that ended, then slowed for those still open (a step that
     starts beside an operator); whether none is left unsent (another sender may hold one)."""
-    slowdowns = Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.SLOW)
-    restores = Q(ended_at__isnull=False, resumed_at__isnull=True)
-    pending = Q(ended_at__isnull=True, paused_at__isnull=True)
     # One statement for the common case, a step with no slowdown to set: it is on every step.
-    due = list(slowdowns.filter(restores | pending).values_list("pk", "ended_at"))
+    due = list(progress.speed_changes_due(cobot_id).values_list("pk", "ended_at"))
     if not due:
         return True
     # The restores first, then the slowdowns still open: a step beside an operator goes slowly.
@@ -95,7 +92,7 @@ def set_speed_before_step(cobot_id: int) -> bool:
             resume_cobot(interruption_id)
         else:
             interrupt_cobot(interruption_id)
-    return not slowdowns.filter(restores | pending).exists()
+    return not progress.speed_changes_due(cobot_id).exists()
 
 
 def _claim(interruption_id: int, due: Q) -> tuple[Interruption, Cobot] | None:
@@ -148,16 +145,9 @@ def ring_next_job_on_commit(cobot_id: int) -> None:
         dispatch.send_on_commit(Task.RUN_JOB, job_id)
 
 
-def holding(cobot_id: int) -> QuerySet[Interruption]:
-    """The pauses that keep the cobot paused (a slowed cobot may run)."""
-    return Interruption.objects.filter(cobot_id=cobot_id, mode=InterruptionMode.PAUSE).filter(
-        Q(ended_at__isnull=True) | Q(paused_at__isnull=False, resumed_at__isnull=True)
-    )
-
-
 def holds_cobot(cobot_id: int) -> bool:
     """Whether an operator's interruption still keeps the cobot paused (a STOP's resume asks)."""
-    return holding(cobot_id).exists()
+    return progress.unsettled_pauses(cobot_id).exists()
 
 
 def to_redo() -> list[tuple[Task, int]]:

@@ -222,7 +222,7 @@ def _lease_next(which: str, key: int, *, hand_over: bool = False) -> Lease | Non
     return None
 
 
-@rows.compiled
+@rows.Compiled
 def _queue(cobot: int, now: dt.datetime) -> QuerySet[Job, Any]:
     """The cobot's queue, with the reasons the whole cobot waits on each row (a job running, a
     pause for an operator in a shared area, a person's command (power, program) under way).
@@ -281,8 +281,7 @@ def _lease_if_ready(
     events.publish_cobot_queue(cobot.pk)
     speed_due = speed_due or item.task in net.space_tasks  # a start beside an operator slows it
     if hand_over:
-        fields = {field: getattr(cobot, field) for field in progress.COBOT_FIELDS}
-        message = progress.leased_message(job, {**fields, "speed_due": speed_due})
+        message = progress.leased_message(job, progress.cobot_fields(cobot), speed_due)
         dispatch.send_on_commit(Task.RUN_LEASED_JOB, message)
     return Lease(
         job.pk, case.pk, job.lease, job.attempt, job.kind, job.command, job.timeout, cobot,
@@ -602,12 +601,11 @@ def _unclaimed(now: dt.datetime, cobot_id: int | None = None) -> list[dict[str, 
         jobs = jobs.filter(cobot_id=cobot_id)
     jobs = jobs.select_related("cobot").order_by("started_at", "id")
     # speed_due: the worker asks, as the slowdowns may have changed since the lease.
-    return [
-        progress.leased_message(
-            job, {**{f: getattr(job.cobot, f) for f in progress.COBOT_FIELDS}, "speed_due": True}
-        )
-        for job in jobs
-    ]
+    messages = []
+    for job in jobs:
+        assert job.cobot is not None  # a step's job is on a cobot
+        messages.append(progress.leased_message(job, progress.cobot_fields(job.cobot), True))
+    return messages
 
 
 def _first_due_per_cobot(now: dt.datetime) -> list[int]:

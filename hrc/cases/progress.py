@@ -498,7 +498,7 @@ def hand_over(case: Case, net: CaseNet) -> None:
         if not cobot["free"]:
             continue
         lease_job(case, net, job, now, held_by="")
-        dispatch.send_on_commit(Task.RUN_LEASED_JOB, leased_message(job, cobot))
+        dispatch.send_on_commit(Task.RUN_LEASED_JOB, leased_message(job, cobot, cobot["speed_due"]))
         marking = Marking(case.marking)
 
 
@@ -522,7 +522,7 @@ def _take_free_cobot(job: Job) -> dict[str, Any] | None:
     }  # fmt: skip
 
 
-@rows.compiled
+@rows.Compiled
 def _cobot_for(cobot: int, job: int, case: int, now: dt.datetime) -> QuerySet[Cobot, Any]:
     here = OuterRef("pk")
     others = Job.objects.filter(cobot=here).exclude(pk=job)
@@ -544,14 +544,20 @@ def _cobot_for(cobot: int, job: int, case: int, now: dt.datetime) -> QuerySet[Co
     )  # fmt: skip
 
 
-def leased_message(job: Job, cobot: Mapping[str, Any]) -> dict[str, Any]:
+def leased_message(job: Job, cobot: Mapping[str, Any], speed_due: bool) -> dict[str, Any]:
     """What a worker needs to drive a job leased for it without reading it again: the lease,
-    the command, and the cobot's COBOT_FIELDS and `speed_due` (jobs.Lease.from_message)."""
+    the command, the cobot's COBOT_FIELDS (`cobot`, or cobot_fields) and whether a speed
+    change waits to be sent before the step (jobs.Lease.from_message)."""
     return {
         "job": job.pk, "case": job.case_id, "lease": job.lease, "attempt": job.attempt,
         "kind": job.kind, "command": job.command, "timeout": job.timeout,
-        "cobot": {field: cobot[field] for field in (*COBOT_FIELDS, "speed_due")},
+        "cobot": {**{field: cobot[field] for field in COBOT_FIELDS}, "speed_due": speed_due},
     }  # fmt: skip
+
+
+def cobot_fields(cobot: Cobot) -> dict[str, Any]:
+    """The cobot's COBOT_FIELDS, as leased_message takes them."""
+    return {field: getattr(cobot, field) for field in COBOT_FIELDS}
 
 
 def unsettled_pauses(cobot: Cobot | int | OuterRef) -> QuerySet[Interruption]:
@@ -890,7 +896,7 @@ def ring_for_next_job_on_commit(job_id: int, cobot_id: int) -> None:
     dispatch.send_on_commit_if(lambda: bool(_queued_on(cobot=cobot_id)), Task.RUN_JOB, job_id)
 
 
-@rows.compiled
+@rows.Compiled
 def _queued_on(cobot: int) -> QuerySet[Job, Any]:  # asked after each step: compiled once
     return Job.objects.filter(cobot_id=cobot, state=JobState.QUEUED).values_list("pk")[:1]
 

@@ -20,7 +20,7 @@ from django.db.models import Field, Model, QuerySet
 
 M = TypeVar("M", bound=Model)
 Converter = Callable[[Any, Any, Any], Any]
-# Stand-ins for a compiled query's values (see compiled): none is a value a query meets.
+# Stand-ins for a compiled query's values (see Compiled): none is a value a query meets.
 _FIRST_STAND_IN = -7_100_000_000
 _STAND_IN_EPOCH = dt.datetime(1901, 1, 1, tzinfo=dt.UTC)
 _STAND_IN_SPACING = dt.timedelta(days=3650)  # a value may be offset by less than half of this
@@ -84,9 +84,8 @@ def update(instance: Model, fields: Sequence[str]) -> int:
     """UPDATE of the instance's row: these fields, by its primary key; the rows changed."""
     model = type(instance)
     sql, chosen = _update_sql(model, tuple(fields))
-    params = [field.get_db_prep_save(field.pre_save(instance, False), connection) for field in chosen]  # fmt: skip
     with connection.cursor() as cursor:
-        cursor.execute(sql, [*params, instance.pk])
+        cursor.execute(sql, [*_values(instance, chosen, adding=False), instance.pk])
         return int(cursor.rowcount)
 
 
@@ -111,19 +110,17 @@ def save_with(
     parts: list[str] = []
     params: list[Any] = []
     if inserts:
-        sql, columns = _insert_sql(type(inserts[0]))
-        head = sql.split(" VALUES ", 1)[0]
+        head, columns = _insert_head(type(inserts[0]))
         values = f"({', '.join(['%s'] * len(columns))})"
         parts.append(f"inserted AS ({head} VALUES {', '.join([values] * len(inserts))})")
         for new in inserts:
-            params += [field.get_db_prep_save(field.pre_save(new, True), connection) for field in columns]  # fmt: skip
+            params += _values(new, columns, adding=True)
     for index, (other, changed) in enumerate(updates):
         sql, chosen = _update_sql(type(other), tuple(changed))
         parts.append(f"updated_{index} AS ({sql})")
-        params += [field.get_db_prep_save(field.pre_save(other, False), connection) for field in chosen]  # fmt: skip
-        params.append(other.pk)
+        params += [*_values(other, chosen, adding=False), other.pk]
     sql, chosen = _update_sql(type(instance), tuple(fields))
-    params += [field.get_db_prep_save(field.pre_save(instance, False), connection) for field in chosen]  # fmt: skip
+    params += _values(instance, chosen, adding=False)
     with connection.cursor() as cursor:
         cursor.execute(f"WITH {', '.join(parts)} {sql}" if parts else sql, [*params, instance.pk])
     for new in inserts:
@@ -133,12 +130,20 @@ def save_with(
 def insert(instance: Model) -> None:
     """INSERT of a new instance, as Model.save() would (defaults, auto_now_add); sets its pk."""
     model = type(instance)
-    sql, fields = _insert_sql(model)
-    params = [field.get_db_prep_save(field.pre_save(instance, True), connection) for field in fields]  # fmt: skip
+    head, fields = _insert_head(model)
+    primary = connection.ops.quote_name(_column(model._meta.pk))
+    sql = f"{head} VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}"
     with connection.cursor() as cursor:
-        cursor.execute(sql, params)
+        cursor.execute(sql, _values(instance, fields, adding=True))
         instance.pk = cursor.fetchone()[0]
     instance._state.adding, instance._state.db = False, connection.alias
+
+
+def _values(instance: Model, fields: Sequence[Field[Any, Any]], *, adding: bool) -> list[Any]:
+    """The instance's values of `fields` as the database takes them, as Model.save() sends them."""
+    return [
+        field.get_db_prep_save(field.pre_save(instance, adding), connection) for field in fields
+    ]
 
 
 def table(model: type[Model]) -> str:
@@ -199,15 +204,13 @@ def _update_sql(model: type[Model], names: tuple[str, ...]) -> tuple[str, list[F
 
 
 @functools.cache
-def _insert_sql(model: type[Model]) -> tuple[str, list[Field[Any, Any]]]:
+def _insert_head(model: type[Model]) -> tuple[str, list[Field[Any, Any]]]:
+    """The INSERT's head (its table and columns: the model's fields but the primary key), and
+    the fields."""
     quote = connection.ops.quote_name
     fields = [field for field in model._meta.concrete_fields if not field.primary_key]
-    primary = quote(_column(model._meta.pk))
-    sql = (
-        f"INSERT INTO {table(model)} ({', '.join(quote(_column(field)) for field in fields)}) "
-        f"VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}"
-    )
-    return sql, fields
+    head = f"INSERT INTO {table(model)} ({', '.join(quote(_column(field)) for field in fields)})"
+    return head, fields
 
 
 def _column(field: Field[Any, Any]) -> str:
@@ -249,11 +252,6 @@ class Compiled:
             sql, params = self.build(**stand_ins).query.sql_with_params()
             self._sql[key] = (sql, list(params), stand_ins)
         return self._sql[key]
-
-
-def compiled(build: Callable[..., QuerySet[Any, Any]]) -> Compiled:
-    """Compiled, as a decorator of the function that builds the query."""
-    return Compiled(build)
 
 
 def _stand_in(index: int, value: object) -> int | dt.datetime:
