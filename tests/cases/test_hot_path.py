@@ -80,6 +80,25 @@ def _job(item: WorkItem) -> Job:
     return Job.objects.select_related("cobot").get(case_id=item.case_id)
 
 
+def _leased(item: WorkItem, operator: User) -> jobs.Lease:
+    """Completes the started task; the lease its step's message carries (the cobot was free)."""
+    with sent_tasks() as sent:
+        services.complete_work_item(item, user=operator)
+    [(task, (message,))] = sent
+    assert task == Task.RUN_LEASED_JOB
+    return jobs.Lease.from_message(message)
+
+
+def _queued(items: list[WorkItem], operator: User, cobot: Cobot) -> None:
+    """Completes the started tasks while the cobot's cell is stopped, so that their steps wait
+    in its queue, then lets the cell go (in its row only: no doorbell rings)."""
+    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=timezone.now())
+    with sent_tasks():
+        for item in items:
+            services.complete_work_item(item, user=operator)
+    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=None)
+
+
 def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a_doorbell(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
@@ -152,10 +171,7 @@ def test_a_worker_claims_a_leased_step_once_in_one_statement(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
     item = _started(version, engineer, operator, cobot)
-    with sent_tasks() as sent:
-        services.complete_work_item(item, user=operator)
-    [(_, (message,))] = sent
-    lease = jobs.Lease.from_message(message)
+    lease = _leased(item, operator)
     with counted() as statements:
         assert jobs._claim(lease)
     assert len(statements.sent) == 1
@@ -183,9 +199,7 @@ def test_the_finish_runs_a_fixed_number_of_statements(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
     item = _started(version, engineer, operator, cobot)
-    with sent_tasks() as sent:
-        services.complete_work_item(item, user=operator)
-    lease = jobs.Lease.from_message(sent[0][1][0])
+    lease = _leased(item, operator)
     assert jobs._claim(lease)
     with sent_tasks(), counted() as statements:
         jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0})
@@ -199,11 +213,8 @@ def test_the_finish_runs_a_fixed_number_of_statements(
 def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=timezone.now())
     item = _started(version, engineer, operator, cobot)
-    with sent_tasks():
-        services.complete_work_item(item, user=operator)  # queued: the cell is stopped
-    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=None)
+    _queued([item], operator, cobot)
     with counted() as statements:
         lease = jobs._lease_next("id = %s", cobot.pk)  # what a doorbell runs (run_next_job)
     assert lease is not None
@@ -218,10 +229,9 @@ def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_
 ) -> None:
     first = _started(version, engineer, operator, cobot)
     second = _started(version, engineer, operator, cobot)
-    with sent_tasks() as sent:
-        services.complete_work_item(first, user=operator)
+    lease = _leased(first, operator)
+    with sent_tasks():
         services.complete_work_item(second, user=operator)  # queued behind the first
-    lease = jobs.Lease.from_message(sent[0][1][0])
     assert jobs._claim(lease)
     with sent_tasks() as rung:
         jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0}, ring=False)
@@ -238,12 +248,7 @@ def test_a_lease_handed_to_the_workers_is_the_cobots_only_one(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
     """The lease that hands the next job over ends the lease: the cobot has a job running."""
-    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=timezone.now())
-    items = [_started(version, engineer, operator, cobot) for _ in range(3)]
-    with sent_tasks():
-        for item in items:
-            services.complete_work_item(item, user=operator)  # queued: the cell is stopped
-    Cobot.objects.filter(pk=cobot.pk).update(stopped_at=None)
+    _queued([_started(version, engineer, operator, cobot) for _ in range(3)], operator, cobot)
     with sent_tasks() as rung:
         jobs._lease_next("id = %s", cobot.pk, hand_over=True)
     assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
