@@ -32,7 +32,8 @@ from typing import Any
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import Exists, OuterRef, QuerySet
+from django.db.models import Exists, F, OuterRef, QuerySet, Window
+from django.db.models.functions import RowNumber
 from django.utils import timezone
 
 from hrc.cases import dispatch, events, interruptions, progress, rows
@@ -590,13 +591,14 @@ def sweep() -> dict[str, int]:
 
 def _unclaimed(now: dt.datetime, cobot_id: int | None = None) -> list[dict[str, Any]]:
     """The messages of the jobs a completion leased that no worker has claimed: for the sweeper
-    (no `cobot_id`), those a sweep's time old (their message lost with the broker, or the
-    workers busy), which it sends again, as a claim takes a lease once; else the cobot's. (Left
+    (no `cobot_id`), those whose age calls for a copy (_send_again: their message lost with
+    the broker, or the workers busy), which it sends again, as a claim takes a lease once;
+    else the cobot's. (Left
     unclaimed until the lease expires, a job is queued again: _expire_lease.)"""
     jobs = Job.objects.filter(state=JobState.RUNNING, held_by="", kind=WorkItemKind.STEP)
+    period = settings.HRC_SWEEP_SECONDS
     if cobot_id is None:
-        waited = now - dt.timedelta(seconds=settings.HRC_SWEEP_SECONDS)
-        jobs = jobs.filter(started_at__lt=waited)
+        jobs = jobs.filter(started_at__lt=now - dt.timedelta(seconds=period))
     else:
         jobs = jobs.filter(cobot_id=cobot_id)
     jobs = jobs.select_related("cobot").order_by("started_at", "id")
@@ -604,24 +606,49 @@ def _unclaimed(now: dt.datetime, cobot_id: int | None = None) -> list[dict[str, 
     messages = []
     for job in jobs:
         assert job.cobot is not None  # a step's job is on a cobot
+        assert job.started_at is not None  # leased
+        if cobot_id is None and not _send_again(now - job.started_at, period):
+            continue
         messages.append(progress.leased_message(job, progress.cobot_fields(job.cobot), True))
     return messages
 
 
+def _send_again(age: dt.timedelta, period: float) -> bool:
+    """Whether the sweeper sends an unclaimed lease's message again, the lease `age` old: at
+    1, 2, 4, 8… sweep periods of age, not at every sweep. While the workers are busy a lease
+    waits its turn in the broker, and a copy at every sweep would lengthen the queue it waits
+    in; a lost message still goes again within twice its age, and a lease nobody claims
+    expires (_expire_lease)."""
+    if period <= 0:
+        return True
+    sweeps = int(age.total_seconds() / period)
+    return sweeps >= 1 and sweeps & (sweeps - 1) == 0
+
+
 def _first_due_per_cobot(now: dt.datetime) -> list[int]:
     """The first due job of each queue (a cobot's, a device's) that has nothing running,
-    leaving out the jobs another case's func hold keeps waiting (the holding case's own may go)."""
-    queues = ("cobot_id", "device_id")
-    busy = set(Job.objects.filter(state=JobState.RUNNING).values_list(*queues))
-    firsts: dict[tuple[int | None, int | None], int] = {}
-    due = Job.objects.filter(
-        state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
-    ).exclude(Exists(_held_by_another_case(OuterRef("cobot_id"))))
-    for job_id, *queue in due.order_by("queued_at", "id").values_list("pk", *queues):
-        key = (queue[0], queue[1])
-        if key not in busy:
-            firsts.setdefault(key, job_id)
-    return list(firsts.values())
+    leaving out the jobs another case's func hold keeps waiting (the holding case's own may go).
+
+    One statement, which hands back one job per queue: the sweeper runs every few seconds
+    however long the queues have grown.
+    """
+    running = Job.objects.filter(state=JobState.RUNNING)
+    first_in_queue = Window(
+        RowNumber(),
+        partition_by=[F("cobot_id"), F("device_id")],
+        order_by=[F("queued_at").asc(), F("id").asc()],
+    )
+    due = (
+        Job.objects.filter(
+            state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING
+        )
+        .exclude(Exists(running.filter(cobot_id=OuterRef("cobot_id"))))
+        .exclude(Exists(running.filter(device_id=OuterRef("device_id"))))
+        .exclude(Exists(_held_by_another_case(OuterRef("cobot_id"))))
+        .annotate(place=first_in_queue)
+        .filter(place=1)
+    )
+    return list(due.order_by("queued_at", "id").values_list("pk", flat=True))
 
 
 def _expire_lease(job_id: int, case_id: int) -> None:

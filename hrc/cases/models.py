@@ -240,6 +240,18 @@ class Job(models.Model):
         indexes = [
             models.Index(fields=["cobot", "state", "queued_at"]),
             models.Index(fields=["device", "state", "queued_at"]),
+            # The sweeper's reads, every few seconds: the jobs waiting or running, a handful
+            # however many the plant has run.
+            models.Index(
+                fields=["queued_at", "id"],
+                condition=Q(state=JobState.QUEUED),
+                name="job_queued",
+            ),
+            models.Index(
+                fields=["started_at", "id"],
+                condition=Q(state=JobState.RUNNING),
+                name="job_running",
+            ),
         ]
         constraints = [
             # In one queue exactly: a cobot's or a device's.

@@ -10,6 +10,7 @@ one on the same cobot (two use-case cases sharing cobots did exactly that).
 
 from __future__ import annotations
 
+import datetime as dt
 import threading
 from typing import Any
 
@@ -17,6 +18,7 @@ import pytest
 import redis
 from django.contrib.auth.models import User
 from django.db import connection, connections, transaction
+from django.test.utils import CaptureQueriesContext
 from django.utils import timezone
 
 from hrc.cases import jobs
@@ -70,10 +72,16 @@ def _one_cobot_task() -> dict[str, Any]:
 
 def _two_jobs_queued_on_one_cobot(organisation: Organisation, engineer: User, operator: User) -> Cobot:  # fmt: skip
     """Two cases of _one_cobot_task on the same cobot: both jobs queued as the cases start."""
+    return _jobs_queued_on_a_cobot(organisation, engineer, operator, "shared", 2)
+
+
+def _jobs_queued_on_a_cobot(
+    organisation: Organisation, engineer: User, operator: User, name: str, count: int
+) -> Cobot:
     version = factories.make_version(organisation, published_by=engineer, draft=_one_cobot_task())
-    cobot = factories.make_cobot(organisation, name="shared")
+    cobot = factories.make_cobot(organisation, name=name)
     mapping = {"c": {"cobot": cobot.pk}, "o": {"users": [operator.pk]}}
-    for _ in range(2):
+    for _ in range(count):
         factories.make_case(version, started_by=engineer, actor_mapping=mapping)
     return cobot
 
@@ -183,3 +191,23 @@ def test_a_cancelled_cases_job_whose_lease_expires_ends_with_the_case_not_back_i
     job = Job.objects.get(pk=lease.job_id)
     assert job.state == JobState.CANCELLED
     assert job.ended_at is not None
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("queued", [3, 30])
+def test_the_sweeper_rings_each_cobots_first_due_job_in_one_read_however_long_the_queue(
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User, queued: int
+) -> None:
+    # `broker`: the doorbells go to a private redis-server that no worker reads.
+    busy = _jobs_queued_on_a_cobot(organisation, engineer, operator, "busy", 2)
+    waiting = _jobs_queued_on_a_cobot(organisation, engineer, operator, "waiting", queued)
+    assert jobs.lease_next_job(busy.pk) is not None  # busy runs a step: no doorbell for it
+    backing_off, first_due, *_ = Job.objects.filter(cobot=waiting).order_by("queued_at", "id")
+    Job.objects.filter(pk=backing_off.pk).update(  # its last try failed: not due yet
+        next_try_at=timezone.now() + dt.timedelta(minutes=1)
+    )
+
+    with CaptureQueriesContext(connection) as queries:
+        assert jobs._first_due_per_cobot(timezone.now()) == [first_due.pk]
+
+    assert len(queries) == 1

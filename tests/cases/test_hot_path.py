@@ -4,6 +4,7 @@ number of statements (counted here, so that a change cannot add one silently).""
 
 from __future__ import annotations
 
+import datetime as dt
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -193,6 +194,25 @@ def test_the_sweeper_sends_an_unclaimed_lease_again(
     assert jobs._claim(jobs.Lease.from_message(message))
     with sent_tasks():
         assert jobs.sweep()["unclaimed"] == 0  # claimed: nothing to send
+
+
+def test_an_unclaimed_lease_is_sent_again_at_1_2_4_8_sweeps_of_age_not_at_every_sweep(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot, settings: Any
+) -> None:
+    settings.HRC_SWEEP_SECONDS = 2.0
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks():
+        services.complete_work_item(item, user=operator)  # its message lost, or waiting its turn
+    leased_at = _job(item).started_at
+    assert leased_at is not None
+
+    sent_at = [
+        sweeps
+        for sweeps in range(12)
+        if jobs._unclaimed(leased_at + dt.timedelta(seconds=2.0 * sweeps + 0.1))
+    ]
+
+    assert sent_at == [1, 2, 4, 8]
 
 
 def test_the_finish_runs_a_fixed_number_of_statements(
