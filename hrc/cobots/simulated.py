@@ -8,6 +8,7 @@ same port with the same simulator state file, as a gateway host restarts.
 from __future__ import annotations
 
 import os
+import random
 import signal
 import socket
 import subprocess
@@ -21,11 +22,33 @@ _ROOT = Path(__file__).resolve().parents[2]
 TIME_SCALE = 0.05
 
 
+# Servers started here listen on a port drawn from this range, below the kernel's ephemeral
+# ports (32768 and up on Linux): a port the kernel hands out for port 0 may be taken by any
+# outgoing connection between the probe and the server's bind, or while a gateway restarts.
+_PORTS = range(20000, 32768)
+# Not the `random` module's shared generator: a test that seeds it would make parallel test
+# processes draw the same ports.
+_DRAW = random.SystemRandom()
+# The ports this process has handed out: each goes to a server that may not have bound it yet
+# (the gateways of one run are given theirs before any starts), so none is handed out twice.
+_GIVEN: set[int] = set()
+
+
 def free_port() -> int:
-    """A TCP port free on 127.0.0.1 right now (closed again, reused by the gateway)."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
+    """A TCP port free on 127.0.0.1 right now (closed again, bound later by a server), never
+    one this process has handed out before."""
+    for _ in range(200):
+        port = _DRAW.choice(_PORTS)
+        if port in _GIVEN:
+            continue
+        with socket.socket() as probe:
+            try:
+                probe.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+        _GIVEN.add(port)
+        return port
+    raise OSError(f"no free port on 127.0.0.1 in {_PORTS.start}-{_PORTS.stop - 1}")
 
 
 class GatewayProcess:

@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import socket
 import stat
 import subprocess
 import sys
@@ -34,6 +33,7 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 from django.core.management import call_command
 from django.core.management.base import CommandError
 
+from hrc.cobots.simulated import free_port
 from hrc_gateway import pki
 from hrc_gateway.pki import PkiError
 
@@ -49,15 +49,6 @@ NO_SERVER = cast("InternalServer", None)
 
 # The async tests share the module's event loop, so they can share its gateways.
 module_loop = pytest.mark.asyncio(loop_scope="module")
-
-
-def _free_port() -> int:
-    # asyncua builds its endpoint URL from the configured port, so port 0
-    # would be announced as 0: pick a free one and hand it over.
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
 
 
 @pytest.fixture(scope="module")
@@ -98,7 +89,7 @@ async def _gateway(
     """A running asyncua server secured by `secure_server` (or not at all); yields its URL."""
     server = Server()
     await server.init()
-    url = f"opc.tcp://127.0.0.1:{_free_port()}/"
+    url = f"opc.tcp://127.0.0.1:{free_port()}/"
     server.set_endpoint(url)
     if insecure:
         server.set_security_policy([ua.SecurityPolicyType.NoSecurity])

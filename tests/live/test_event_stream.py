@@ -4,11 +4,13 @@ exactly the snapshot a tablet that connects afterwards gets."""
 
 from __future__ import annotations
 
+import datetime as dt
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
+from django.db.models import Max
 
 from hrc.cases import services as case_services
 from hrc.cases.choices import CaseStatus, JobState, WorkItemState
@@ -50,8 +52,10 @@ def test_deltas_applied_to_an_old_snapshot_give_the_fresh_snapshot(
     cookie = session_cookie(operator)
     captured: list[dict[str, Any]] = []
 
-    def run_cases(first: int, second: int, third: int) -> None:
-        """Two cases run to their end while a third waits, started, and a fourth is offered."""
+    def run_cases(first: int, second: int, third: int) -> float:
+        """Two cases run to their end while a third waits, started, and a fourth is offered.
+
+        Returns when the last step finished (seconds since the epoch)."""
         for case_id in (first, second):
             item = _operator_item(case_id)
             case_services.start_work_item(item, user=operator)
@@ -70,6 +74,8 @@ def test_deltas_applied_to_an_old_snapshot_give_the_fresh_snapshot(
             timeout=60,
         )
         groups.flush()
+        last_finish: dt.datetime = Job.objects.aggregate(last=Max("ended_at"))["last"]
+        return last_finish.timestamp()
 
     async def scenario() -> None:
         cases = await db(simulation.start_cases, 3)
@@ -78,18 +84,23 @@ def test_deltas_applied_to_an_old_snapshot_give_the_fresh_snapshot(
         old = await receive(socket)
         assert [case["id"] for case in old["cases"]] == cases
         with simulation.running(operators=False):
-            await db(run_cases, *cases)
-        # The last deltas sent are the two cases' completions and the new case's offer (in
-        # either order), and a consumer passes on its channel's messages in order: once they
-        # are here, everything sent before is too. (A resync at once could be answered first:
+            last_finish = await db(run_cases, *cases)
+        # The last case deltas are the two cases' completions and the new case's offer (in
+        # either order). The cobot's queue is read apart from them, by whichever process
+        # changed it, a window later: its last word is an empty queue read after the last
+        # step finished, and the newest read wins. (A resync at once could be answered first:
         # the socket's frames and the channel layer's messages race in the consumer.)
         last: set[tuple[str, int]] = set()
+        newest_queue: dict[str, Any] = {"at": 0.0}
 
         def all_sent_arrived(event: dict[str, Any]) -> bool:
             kind = event.get("event")  # cobot queues have none
             if kind == "case-completed" or (kind == "task-offered" and event["case"] not in cases):
                 last.add((kind, event["case"]))
-            return len(last) == 3
+            if event["type"] == "cobot-queue" and event["queue"]["at"] > newest_queue["at"]:
+                newest_queue.update(event["queue"])
+            queue_settled = newest_queue["at"] > last_finish and newest_queue["current"] is None
+            return len(last) == 3 and queue_settled
 
         await receive_until(socket, all_sent_arrived, into=captured)
         await socket.send('{"type": "resync"}')

@@ -30,6 +30,20 @@ export function addElement<K extends keyof HTMLElementTagNameMap>(
   return parent.appendChild(element(tag, attributes, ...children));
 }
 
+/**
+ * Makes `parent`'s children equal to `wanted`, keeping every child that already equals the one
+ * wanted in its place: a live page renders on every update, and a button replaced between an
+ * operator's press and release loses the tap.
+ */
+export function patchChildren(parent: Element, wanted: Node[]): void {
+  wanted.forEach((node, index) => {
+    const current = parent.childNodes[index];
+    if (!current) parent.append(node);
+    else if (!current.isEqualNode(node)) current.replaceWith(node);
+  });
+  while (parent.childNodes.length > wanted.length) parent.lastChild!.remove();
+}
+
 /** The JSON of the page's `<script type="application/json" id=…>` (Django's json_script); null without one. */
 export function pageConfig<T>(id: string): T | null {
   const source = document.getElementById(id)?.textContent;

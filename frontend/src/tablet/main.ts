@@ -4,7 +4,7 @@ import "./tablet.css";
 import type { CobotData, LiveEvent, WorkItemData } from "../live/events";
 import { type ConnectionStatus, LiveSocket } from "../live/socket";
 import { type LiveState, LiveStore } from "../live/store";
-import { element, pageConfig } from "../shared/dom";
+import { element, pageConfig, patchChildren } from "../shared/dom";
 import { ApiError, problemOf, request } from "../shared/http";
 import { buildForm, type FormSchema } from "./form";
 import {
@@ -105,11 +105,8 @@ function renderWaiting(state: LiveState): void {
 }
 
 function renderCards(container: HTMLElement, items: WorkItemData[], state: LiveState, empty: string): void {
-  if (!items.length) {
-    container.replaceChildren(element("p", "empty", empty));
-    return;
-  }
-  container.replaceChildren(...items.map((item) => card(item, state)));
+  const cards = items.length ? items.map((item) => card(item, state)) : [element("p", "empty", empty)];
+  patchChildren(container, cards); // a card unchanged keeps its buttons under the operator's finger
 }
 
 function card(item: WorkItemData, state: LiveState): HTMLElement {

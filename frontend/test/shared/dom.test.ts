@@ -1,6 +1,6 @@
 import { afterEach, describe, expect, it } from "vitest";
 
-import { addElement, element, pageConfig } from "../../src/shared/dom";
+import { addElement, element, pageConfig, patchChildren } from "../../src/shared/dom";
 
 describe("the DOM helpers", () => {
   afterEach(() => document.body.replaceChildren());
@@ -24,6 +24,18 @@ describe("the DOM helpers", () => {
     const button: HTMLButtonElement = addElement(list, "button", { type: "button" }, "Play");
     expect(list.lastChild).toBe(button);
     expect(button.type).toBe("button");
+  });
+
+  it("keeps the children that equal the ones wanted and replaces, adds and drops the others", () => {
+    const list = element("ul", "", element("li", "", "a"), element("li", "", "b"), element("li", "", "c"));
+    const [first, second] = [...list.children];
+    patchChildren(list, [element("li", "", "a"), element("li", "", "B")]);
+    expect(list.outerHTML).toBe("<ul><li>a</li><li>B</li></ul>");
+    expect(list.firstChild).toBe(first); // the same node: a press on it goes on
+    expect(list.lastChild).not.toBe(second);
+    patchChildren(list, [element("li", "", "a"), element("li", "", "B"), element("li", "", "d")]);
+    expect(list.outerHTML).toBe("<ul><li>a</li><li>B</li><li>d</li></ul>");
+    expect(list.firstChild).toBe(first);
   });
 
   it("reads the page's JSON configuration, or null without one", () => {
