@@ -32,12 +32,12 @@ import tempfile
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from bench.report import load_average, print_load, write_results
+from bench.report import load_average, print_load, settings_json, write_results
 from bench.runtime_rig import (
     RESULTS_DIR,
     SETTINGS_MODULE,
@@ -381,7 +381,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
         "load_average": {"before": load_before, "after": load_average()},
-        "settings": {k: v for k, v in asdict(settings).items() if k != "results_dir"},
+        "settings": settings_json(settings),
         "pattern": SHAPE,
         **ours,
         "floor": floor,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
+from dataclasses import asdict
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,16 @@ def load_average() -> list[float] | None:
         return [round(value, 2) for value in os.getloadavg()]
     except OSError:
         return None
+
+
+def settings_json(settings: Any) -> dict[str, Any]:
+    """A bench's settings (a dataclass) as its report records them: tuples as lists, without
+    where the results go."""
+    return {
+        key: list(value) if isinstance(value, tuple) else value
+        for key, value in asdict(settings).items()
+        if key != "results_dir"
+    }
 
 
 def write_results(results_dir: Path, name: str, report: Mapping[str, Any]) -> None:

@@ -50,7 +50,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Self
 
-from bench.report import load_average, print_load, write_results
+from bench.report import load_average, print_load, settings_json, write_results
 from bench.runtime_rig import (
     FLOOR_QUEUE,
     FLOOR_REGISTER,
@@ -756,7 +756,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
         "load_average": {"before": load_before, "after": load_average()},
-        "settings": {key: value for key, value in asdict(settings).items() if key != "results_dir"},
+        "settings": settings_json(settings),
         "signalling": signalling,
         "throughput": throughput,
         "log_length": log_length,

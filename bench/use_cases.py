@@ -1,7 +1,7 @@
 """`make bench` (fifth part): the use cases — each one's cycle time against its task times.
 
 Every use case of hrc/patterns/examples/use_cases/ runs as `run_pattern
---simulate` runs it, but on real Celery workers (two, prefork, concurrency
+--simulate` runs it, but on real Celery workers (WORKERS, prefork, concurrency
 1; the first runs the beat and so the sweeper) with a private redis-server
 as the broker, in a scratch PostgreSQL database (hrc_bench_<pid>: created,
 migrated, dropped), against simulated OPC UA gateways at --time-scale (0.1:
@@ -40,12 +40,12 @@ import statistics
 import sys
 import tempfile
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from bench.report import load_average, print_load, write_results
+from bench.report import load_average, print_load, settings_json, write_results
 from bench.runtime_rig import (
     RESULTS_DIR,
     ROOT,
@@ -60,13 +60,17 @@ if TYPE_CHECKING:  # Django's models load only after django.setup(), inside the 
 
 USE_CASES_DIR = ROOT / "hrc" / "patterns" / "examples" / "use_cases"
 CASE_TIMEOUT = 600.0
+# As docker/README.md sizes them: two slots per cobot, for its step and the pause or resume a
+# space constraint sends it meanwhile, and one for device calls (with two, 4b's pauses never
+# arrived while the steps held both).
+WORKERS = 5
 
 
 @dataclass(frozen=True)
 class Settings:
     time_scale: float = 0.1
     rounds: int = 3
-    workers: int = 2
+    workers: int = WORKERS
     only: tuple[str, ...] = ()  # file stems or numbers ("2", "2b"); empty: all of them
     quick: bool = False
     results_dir: Path = field(default=RESULTS_DIR, compare=False)
@@ -207,9 +211,10 @@ def measure_use_case(
 ) -> dict[str, Any]:
     from hrc.cases.simulation import Simulation, case_variants
     from hrc.engine import read_pattern
+    from hrc.engine.runtime import CaseNet
 
     document = json.loads(path.read_text())
-    per_round = max(len(case_variants(document, read_pattern(document))), 1)
+    per_round = max(len(case_variants(document, CaseNet(read_pattern(document)))), 1)
     folder = workdir / path.stem
     folder.mkdir()
     cases: list[dict[str, Any]] = []
@@ -249,11 +254,7 @@ def run(settings: Settings, progress: Callable[[str], None] = print) -> dict[str
         "when": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": host,
         "load_average": {"before": load_before, "after": load_average()},
-        "settings": {
-            key: list(value) if isinstance(value, tuple) else value
-            for key, value in asdict(settings).items()
-            if key != "results_dir"
-        },
+        "settings": settings_json(settings),
         "use_cases": results,
     }
     write_results(settings.results_dir, "use-cases", report)
@@ -290,7 +291,7 @@ def parse_args(argv: Sequence[str] | None = None) -> Settings:
     parser.add_argument("--quick", action="store_true", help=f"a small run: {QUICK}")
     parser.add_argument("--time-scale", type=float, help="robot time per wall second (default 0.1)")
     parser.add_argument("--rounds", type=int, help="rounds per use case (default 3)")
-    parser.add_argument("--workers", type=int, help="Celery workers (default 2)")
+    parser.add_argument("--workers", type=int, help=f"Celery workers (default {WORKERS})")
     parser.add_argument("--only", help="use cases by number or file stem, e.g. 2,5_polishing")
     parser.add_argument("--results-dir", type=Path, default=RESULTS_DIR)
     arguments = parser.parse_args(argv)

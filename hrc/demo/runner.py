@@ -53,6 +53,12 @@ class Plan:
         host = f"[{self.address}]" if ":" in self.address else self.address
         return f"http://{host}:{self.port}"
 
+    @property
+    def worker_slots(self) -> int:
+        """Two Celery processes per cobot, for its step (held while it runs) and for the pause
+        or resume a space constraint sends it meanwhile, and one for device calls."""
+        return 2 * len(self.cobot_ports) + 1
+
     def children(self) -> list[Child]:
         """The processes in start order: gateways, then (with Redis) worker and monitor, then web."""
         python = sys.executable
@@ -64,7 +70,8 @@ class Plan:
                     "worker",
                     [python, "-m", "celery", "-A", "hrc", "worker", "--beat",
                      "--schedule", str(self.logs / "celerybeat-schedule"),
-                     "--hostname", "demo@%h", "--concurrency", "2", "--loglevel", "INFO"],
+                     "--hostname", "demo@%h", "--concurrency", str(self.worker_slots),
+                     "--loglevel", "INFO"],
                     self.logs, ready_text=" ready.",
                 ),
                 Child(

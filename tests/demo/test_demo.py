@@ -96,8 +96,10 @@ def test_with_database_and_redis_urls_it_runs_a_worker_and_the_monitor_and_sigte
             assert asyncio.run(_reachable_cobots(demo, "operator2")) == {"cobot1", "cobot2"}
             children = demo.descendants()
             commands = list(children.values())
-            # The worker, its pool of two and the beat.
-            assert sum("celery -A hrc worker --beat" in command for command in commands) >= 3
+            # The worker, its pool (two slots per cobot, for its step and a pause meanwhile,
+            # and one for device calls) and the beat.
+            assert sum("celery -A hrc worker --beat" in command for command in commands) >= 6
+            assert any("--concurrency 5" in command for command in commands)
             assert sum("live_cobots" in command for command in commands) == 1
             assert sum("cobot_gateway" in command for command in commands) == 2
             assert " ready." in (demo.logs / "worker.log").read_text()
