@@ -6,7 +6,10 @@
 - `reduction`, `analysis`: soundness by reduced state-space exploration, with witnesses;
 - `check`: all of it in one report; `pnml`: PNML import and export;
 - `layout`: automatic layout in actor lanes; `bpmn`, `bpmn_net`, `bpmn_export`: BPMN 2.0
-  import (Dijkman, Dumas and Ouyang's mapping) and export with a diagram.
+  import (Dijkman, Dumas and Ouyang's mapping) and export with a diagram;
+- `prediction`: cycle time, load and bottleneck of a pattern, by a simulation of many cases
+  over the runtime's firing rule (`prediction_run`, `prediction_state`, `prediction_report`);
+  `durations`: task times as distributions, fitted from measured ones.
 """
 
 from hrc.engine.check import CheckReport, check_document, check_pattern

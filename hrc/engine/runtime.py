@@ -154,7 +154,7 @@ class CaseNet:
             if timer is not None:
                 self.timers[transition.id] = timer
         # The silent transitions settle fires: those waiting for neither a message nor a timer.
-        self._eager = tuple(
+        self.eager: tuple[NetTransition, ...] = tuple(
             t
             for t in self.net.transitions
             if t.kind == "silent" and t.id not in self.messages and t.id not in self.timers
@@ -277,12 +277,15 @@ class CaseNet:
             fired.append(transition.id)
 
     def _next_silent(self, marking: Marking, data: Mapping[str, Any]) -> NetTransition | None:
-        for transition in self._eager:
-            if transition.is_enabled(marking) and self._guard_holds(transition.id, data):
+        for transition in self.eager:
+            if transition.is_enabled(marking) and self.guard_holds(transition.id, data):
                 return transition
         return None
 
-    def _guard_holds(self, transition: str, data: Mapping[str, Any]) -> bool:
+    def guard_holds(self, transition: str, data: Mapping[str, Any]) -> bool:
+        """Whether the silent transition's guard holds over `data` (True without one).
+
+        Raises RuntimeFault when the guard cannot be evaluated."""
         guard = self.guards.get(transition)
         if guard is None:
             return True

@@ -12,6 +12,8 @@
 - `faults.py`: the hang and slowdown faults injected into steps.
 - `state.py`: the saved controller state (atomic JSON file).
 - `clock.py`, `publisher.py`: scaled time; publishing only what changed.
+- `timing.py`: the cell without running it (a step's time from its plan, a device's time and
+  odds), for a prediction of a pattern (hrc.engine.prediction's plant).
 
 No asyncua here: the gateway's `GatewaySpace` and `publish` are the only doors out.
 """

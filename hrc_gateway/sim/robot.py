@@ -103,6 +103,22 @@ class ArmState:
         return state
 
 
+def move_profile(
+    start: Joints, target: Joints, tcp: Pose, linear: bool, speed: float, acceleration: float
+) -> Profile:
+    """The motion profile of a move from `start` to `target`: MoveJ by the joint that turns
+    furthest, MoveL by the TCP's travel or turn, whichever takes longer."""
+    if not linear:
+        furthest = max(abs(b - a) for a, b in zip(start, target, strict=True))
+        return Profile(furthest, speed, acceleration)
+    metres, radians = kinematics.pose_distance(
+        kinematics.forward(start, tcp), kinematics.forward(target, tcp)
+    )
+    travel = Profile(metres, speed, acceleration)
+    turn = Profile(radians, MOVEJ_SPEED, MOVEJ_ACCELERATION)
+    return max(travel, turn, key=lambda p: p.duration)
+
+
 # Called with (profile seconds elapsed, robot seconds since the last sample).
 Sample = Callable[[float, float], Awaitable[None]]
 
@@ -326,15 +342,7 @@ class Robot:
     def _profile(
         self, start: Joints, target: Joints, linear: bool, speed: float, acceleration: float
     ) -> Profile:
-        if not linear:
-            furthest = max(abs(b - a) for a, b in zip(start, target, strict=True))
-            return Profile(furthest, speed, acceleration)
-        metres, radians = kinematics.pose_distance(
-            kinematics.forward(start, self.tcp), kinematics.forward(target, self.tcp)
-        )
-        travel = Profile(metres, speed, acceleration)
-        turn = Profile(radians, MOVEJ_SPEED, MOVEJ_ACCELERATION)
-        return max(travel, turn, key=lambda p: p.duration)
+        return move_profile(start, target, self.tcp, linear, speed, acceleration)
 
     async def dwell(self, seconds: float, *, slowdown: float = 1.0) -> None:
         """A program's sleep: `seconds` of robot time, frozen while the program is held."""

@@ -110,3 +110,26 @@ def parallel_lanes(pairs: int, length: int) -> dict[str, Any]:
         if lane % 2:
             constraints += [(f"t{lane - 1}_{i}", f"t{lane}_{i}", "time") for i in range(length)]
     return document(process("N", *chains, performers=performers), constraints=constraints)
+
+
+def with_keys(data: dict[str, Any], **keys: dict[str, Any]) -> dict[str, Any]:
+    """data with keys added to transitions: `xt={"timer": "PT1M"}`."""
+    for net in data["processes"]:
+        for transition in net["transitions"]:
+            transition.update(keys.get(transition["id"], {}))
+    return data
+
+
+def guarded_task(cancels: list[str]) -> dict[str, Any]:
+    """An interrupting timer on the cobot's task ta: xf forks the task and a watch pw; xok ends
+    the watch once ta is done; xt rings after 10 s and cancels `cancels`, xto leads on."""
+    data = document(
+        process(
+            "N",
+            "p0 xf pt ta pd xok p9",
+            "xf pw xt px xto p9",
+            "pw xok",
+            performers={"ta": "c"},
+        )
+    )
+    return with_keys(data, xt={"timer": "PT10S", "cancels": cancels})

@@ -13,17 +13,9 @@ from hrc.engine.reduction import reduce_net
 from hrc.engine.runtime import CaseNet, NotEnabled
 from hrc.engine.tokengame import execution_net_json
 from hrc.engine.wording import Names
-from tests.engine.builders import document, process
+from tests.engine.builders import document, guarded_task, process, with_keys
 
 Doc = dict[str, Any]
-
-
-def _with(data: Doc, **keys: Doc) -> Doc:
-    """data with keys added to transitions: `xt={"timer": "PT1M"}`."""
-    for net in data["processes"]:
-        for transition in net["transitions"]:
-            transition.update(keys.get(transition["id"], {}))
-    return data
 
 
 def _without(data: Doc, key: str) -> Doc:
@@ -39,22 +31,7 @@ def _timer_or_task() -> Doc:
     data = document(
         process("N", "p0 x0 p1 ta p2 x2 p9", "p1 xt p3 tb p9", performers={"ta": "o", "tb": "o"})
     )
-    return _with(data, xt={"timer": "PT1M"})
-
-
-def _guarded_task(cancels: list[str]) -> Doc:
-    """An interrupting timer on the cobot's task ta: xf forks the task and a watch pw; xok ends
-    the watch once ta is done; xt rings after 10 s and cancels `cancels`, xto leads on."""
-    data = document(
-        process(
-            "N",
-            "p0 xf pt ta pd xok p9",
-            "xf pw xt px xto p9",
-            "pw xok",
-            performers={"ta": "c"},
-        )
-    )
-    return _with(data, xt={"timer": "PT10S", "cancels": cancels})
+    return with_keys(data, xt={"timer": "PT1M"})
 
 
 def _terminate(cancels: bool) -> Doc:
@@ -72,7 +49,7 @@ def _terminate(cancels: bool) -> Doc:
     if cancels:
         net = data["processes"][0]
         everything = [p["id"] for p in net["places"]] + [t["id"] for t in net["transitions"]]
-        _with(data, xend={"cancels": everything})
+        with_keys(data, xend={"cancels": everything})
     return data
 
 
@@ -143,7 +120,7 @@ def test_ringing_the_timer_of_a_deferred_choice_withdraws_the_task() -> None:
 
 
 def test_a_cancelled_running_task_can_no_longer_complete() -> None:
-    net = CaseNet(read_pattern(_guarded_task(["ta", "pt", "pd"])))
+    net = CaseNet(read_pattern(guarded_task(["ta", "pt", "pd"])))
     marking, fired = net.settle(net.initial, {})
     assert fired == ["xf"]
     running = net.start(marking, "ta")
@@ -162,7 +139,7 @@ def test_a_cancelled_running_task_can_no_longer_complete() -> None:
 
 
 def test_a_task_that_completes_in_time_ends_the_watch() -> None:
-    net = CaseNet(read_pattern(_guarded_task(["ta", "pt", "pd"])))
+    net = CaseNet(read_pattern(guarded_task(["ta", "pt", "pd"])))
     marking, _ = net.settle(net.initial, {})
 
     done = net.complete(net.start(marking, "ta"), "ta")
@@ -174,7 +151,7 @@ def test_a_task_that_completes_in_time_ends_the_watch() -> None:
 
 
 def test_the_execution_net_resets_the_running_place_of_a_cancelled_task() -> None:
-    net = build_execution_net(read_pattern(_guarded_task(["ta", "pt", "pd", "xok"])))
+    net = build_execution_net(read_pattern(guarded_task(["ta", "pt", "pd", "xok"])))
 
     resets = {t.id: t.resets for t in net.transitions}
 
@@ -185,7 +162,7 @@ def test_the_execution_net_resets_the_running_place_of_a_cancelled_task() -> Non
 
 def test_cancelling_a_supporter_withdraws_its_support_too() -> None:
     # ta (the cobot's) supports to (func): while ta runs, to may start; cancelled, it no longer may.
-    data = _guarded_task(["ta", "pt", "pd", "po", "pq", "to"])
+    data = guarded_task(["ta", "pt", "pd", "po", "pq", "to"])
     net = data["processes"][0]
     net["places"] += [{"id": "po"}, {"id": "pq"}]
     net["transitions"].append({"id": "to", "performer": "o"})
@@ -227,7 +204,7 @@ def test_a_reset_empties_a_place_whatever_it_holds_before_the_outputs_arrive() -
 def test_a_timer_is_judged_as_any_silent_transition() -> None:
     sound = _timer_or_task()
     # Without its join, the timer's branch leaves p2 behind: unsound either way.
-    unsound = _with(
+    unsound = with_keys(
         document(
             process(
                 "N", "p0 x0 p1 ta p2 x2 p9", "x0 p4 xt p3 tb p9", performers={"ta": "o", "tb": "o"}
@@ -265,7 +242,7 @@ def test_without_cancels_the_same_terminate_leaves_work_over() -> None:
 
 def test_a_witness_through_a_cancel_replays_and_names_what_it_missed() -> None:
     # xt forgets pd: after ta completes, the timer can still ring and end the case past pd.
-    data = _guarded_task(["ta", "pt"])
+    data = guarded_task(["ta", "pt"])
     net = build_execution_net(read_pattern(data))
 
     improper = next(e for e in check_document(data).errors if "left over" in e.message)
@@ -285,13 +262,13 @@ def test_a_witness_through_a_cancel_replays_and_names_what_it_missed() -> None:
 
 
 def test_the_cancelled_timer_net_is_sound_and_unsound_without_its_cancels() -> None:
-    assert check_document(_guarded_task(["ta", "pt", "pd"])).sound is True
-    assert check_document(_guarded_task([])).sound is False
+    assert check_document(guarded_task(["ta", "pt", "pd"])).sound is True
+    assert check_document(guarded_task([])).sound is False
 
 
 def test_the_reduction_keeps_a_place_whose_chain_leaves_a_reset_region() -> None:
     # xt empties pt and running:ta but not pd: completing ta takes its token out of the region.
-    net = build_execution_net(read_pattern(_guarded_task(["ta", "pt"])))
+    net = build_execution_net(read_pattern(guarded_task(["ta", "pt"])))
 
     reduced = reduce_net(net)
 
@@ -345,7 +322,7 @@ def test_a_reset_on_the_way_is_no_proof_of_unboundedness() -> None:
 
 
 def test_the_token_game_gets_the_resets() -> None:
-    game = execution_net_json(read_pattern(_guarded_task(["ta", "pt", "pd"])))
+    game = execution_net_json(read_pattern(guarded_task(["ta", "pt", "pd"])))
 
     resets = {t["id"]: t["resets"] for t in game["transitions"]}
 
@@ -355,7 +332,7 @@ def test_the_token_game_gets_the_resets() -> None:
 
 def test_a_firing_sequence_says_a_timer_rings_and_what_a_step_cancels() -> None:
     terminate = Names(read_pattern(_terminate(cancels=True)))
-    timed = Names(read_pattern(_guarded_task(["ta"])))
+    timed = Names(read_pattern(guarded_task(["ta"])))
 
     assert timed.firing("silent", "xt") == "timer xt rings and cancels task ta"
     assert timed.firing("silent", "xto") == "split/join xto fires"
