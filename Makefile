@@ -60,7 +60,7 @@ $(BENCH_STAMP): $(STAMP) requirements/bench-lock.txt
 	$(PIP) install -r requirements/bench-lock.txt 2>&1 | grep -v "is ignored: it is neither" || true
 	@touch $@
 
-bench: $(BENCH_STAMP)  ## soundness check vs Woflan, corpus import, cobot handshake vs raw OPC UA, case runtime; JSON in bench/results/
+bench: $(BENCH_STAMP)  ## soundness check vs Woflan, corpus import, cobot handshake vs raw OPC UA, case runtime, use cases, the prediction against real runs; JSON in bench/results/
 	$(PY) -m bench.run
 	$(PY) -m bench.corpus
 	$(PY) -m bench.handshake
@@ -68,6 +68,7 @@ bench: $(BENCH_STAMP)  ## soundness check vs Woflan, corpus import, cobot handsh
 	$(PY) -m bench.editor
 	$(PY) -m bench.live
 	$(PY) -m bench.use_cases
+	$(PY) -m bench.prediction
 
 lock:  ## re-resolve requirements/*.in into the lock files
 	python3 -m venv /tmp/hrc-lock && /tmp/hrc-lock/bin/pip -q install uv

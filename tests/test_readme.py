@@ -56,6 +56,9 @@ CANNOT_RUN = {
 RUN_HERE = {
     ".venv/bin/python manage.py check_pattern hrc/patterns/examples/*.json",
     ".venv/bin/python manage.py check_pattern --json my-pattern.json",
+    ".venv/bin/python manage.py predict hrc/patterns/examples/use_cases/1_spot_taping.json "
+    "--cases 200 --people o=2",
+    ".venv/bin/python manage.py predict --json --cases 100 my-pattern.json",
     ".venv/bin/python manage.py cobot_certificates cobot1 --user hrc "
     "--password-env COBOT1_PASSWORD",
     ".venv/bin/python manage.py cobot_gateway --name cobot1 --port 4841 --backend sim",
@@ -226,6 +229,16 @@ def test_the_readme_commands_work_on_a_fresh_clone(clone: Clone) -> None:
         replace={"my-pattern.json": str(mine)},
     )
     assert json.loads(checked.stdout)["valid"] is True
+    predicted = clone.run(
+        ".venv/bin/python manage.py predict hrc/patterns/examples/use_cases/1_spot_taping.json "
+        "--cases 200 --people o=2"
+    )
+    assert "200 of 200 cases completed" in predicted.stdout
+    predicted = clone.run(
+        ".venv/bin/python manage.py predict --json --cases 100 my-pattern.json",
+        replace={"my-pattern.json": str(mine)},
+    )
+    assert json.loads(predicted.stdout)["prediction"]["completed"] == 100
 
     # On a fresh clone run_pattern creates and migrates the embedded database itself.
     assert not (clone.scratch / "var" / "hrc.sqlite3").exists()

@@ -20,14 +20,16 @@ from django.db.models.functions import Coalesce
 from hrc.analytics import xes
 from hrc.analytics.gantt import ActorRow, ConstraintRow, Gantt, build_gantt
 from hrc.analytics.metrics import (
+    COMPLETED,
     CaseRow,
     InterruptionRow,
     ItemRow,
     JobRow,
     VersionFigures,
+    item_work_seconds,
     version_figures,
 )
-from hrc.cases.choices import JobState
+from hrc.cases.choices import CaseStatus, EventType, JobState
 from hrc.cases.models import Case, CaseEvent, Interruption, Job, WorkItem
 from hrc.cases.selectors import cases_visible_to
 from hrc.cobots.models import Cobot
@@ -36,7 +38,8 @@ from hrc.engine.document import read_pattern
 from hrc.engine.model import Pattern
 from hrc.organisations.models import Team
 from hrc.organisations.selectors import AnyUser, writable_organisations
-from hrc.patterns.models import PatternVersion
+from hrc.patterns.models import PatternModel, PatternVersion
+from hrc.patterns.prediction import Measured
 from hrc.patterns.selectors import versions_visible_to
 
 # A server-side cursor hands rows over in batches of this many.
@@ -175,6 +178,57 @@ def interruption_rows(cases: QuerySet[Case]) -> list[InterruptionRow]:
     )  # fmt: skip
     interruptions = Interruption.objects.filter(case__in=cases).order_by("started_at", "pk")
     return [InterruptionRow(*row) for row in interruptions.values_list(*fields)]
+
+
+# Measured times, for a prediction (hrc.patterns.prediction) -------------------------------
+
+
+# A prediction reads the latest cases: how the plant works now, and a request's cost that does
+# not grow with the pattern's history.
+MEASURED_CASES = 1000
+
+
+def measured_times(pattern: PatternModel) -> Measured:
+    """What the latest MEASURED_CASES completed cases of the pattern's versions, run in its
+    organisation, measured:
+    each completed task's work time (metrics.item_work_seconds: a cobot task's from its
+    cobot's acceptance of the step) by task id and by label, and how often each silent
+    transition fired (the log's transition-fired events) with the silent transitions those
+    versions had."""
+    cases = Case.objects.filter(
+        pk__in=Case.objects.filter(
+            version__pattern=pattern,
+            organisation_id=pattern.organisation_id,
+            status=CaseStatus.COMPLETED,
+        ).order_by("-ended_at", "-pk")[:MEASURED_CASES]
+    )
+    by_task: dict[str, list[float]] = {}
+    by_label: dict[str, list[float]] = {}
+    for item in item_rows(cases):
+        seconds = item_work_seconds(item) if item.state == COMPLETED else None
+        if seconds is None:
+            continue
+        by_task.setdefault(item.task, []).append(seconds)
+        by_label.setdefault(item.label or item.task, []).append(seconds)
+    fired = dict(
+        CaseEvent.objects.filter(case__in=cases, type=EventType.TRANSITION_FIRED)
+        .order_by()  # the model's ordering would split the groups
+        .values("task")
+        .annotate(count=Count("pk"))
+        .values_list("task", "count")
+    )
+    return Measured(by_task, by_label, fired, _silent_transitions(pattern, cases))
+
+
+def _silent_transitions(pattern: PatternModel, cases: QuerySet[Case]) -> frozenset[str]:
+    """The silent transitions of the versions that have completed cases."""
+    versions = PatternVersion.objects.filter(pattern=pattern, cases__in=cases).distinct()
+    silent: set[str] = set()
+    for version in versions:
+        read = _pattern(version)
+        if read is not None:
+            silent.update(t.id for _, t in read.transitions() if not t.is_task)
+    return frozenset(silent)
 
 
 # A case's Gantt chart -----------------------------------------------------------------------

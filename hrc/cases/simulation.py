@@ -4,21 +4,25 @@ What `manage.py run_pattern --simulate` does, kept here so tests and the
 benchmark drive the very same thing: a scratch organisation with one user per
 operator actor and one simulated gateway (a real OPC UA server process) per
 cobot actor; the pattern published there; N cases started; every operator
-task started as soon as it is offered and completed after a short random
+task started as soon as it is offered and completed after its time: drawn from
+the task's distribution where `durations` gives one (hrc.engine.durations, the
+prediction's own, from the run's seeded random source), else a short random
 delay. Jobs run either on this process's threads (`inline`) or on Celery
 workers started elsewhere.
 
-What a simulated operator enters in a form (`example_for`): for each
+What a simulated operator enters in a form is the engine's rule
+(hrc.engine.forms.example_answers), the one the prediction follows: for each
 required field, the field's `examples` in turn (the n-th time the operator
 completes that task in a case it answers examples[n mod len], so a fixture's
 `"examples": ["top right", "bottom left", …]` is the order that operator
-mounts in), else its `default`, else its first `enum` value, else a value of
-its type.
+mounts in), else its first `enum` value, its `default`, or a value of its
+type.
 
 A document may say how its cases differ from each other (the extended spot
 taping: one case per operator, the second with the other workspace and the
 cobots swapped) under `"simulation": {"cases": [...]}`; case i of a run is
-`cases[i mod len]`:
+`cases[i mod len]` (read as the prediction reads them,
+hrc.engine.prediction.case_variants):
 
     {"name": "operator 2", "data": {"workspace": 1},
      "actors": {"o": "o2", "cL": "cR", "cR": "cL"}}
@@ -57,7 +61,11 @@ from hrc.cobots import services as cobot_services
 from hrc.cobots.drivers.runner import SyncDriver, driver_for
 from hrc.cobots.models import Cobot, Device
 from hrc.cobots.simulated import GatewayProcess
-from hrc.engine.model import Pattern
+from hrc.engine import prediction
+from hrc.engine.durations import Duration
+from hrc.engine.forms import example_answers
+from hrc.engine.prediction import CaseVariant
+from hrc.engine.runtime import CaseNet
 from hrc.engine.taskconfig import DEVICE_KINDS, device_kind_of, device_kinds_called
 from hrc.errors import Refusal
 from hrc.organisations.choices import Role
@@ -110,43 +118,21 @@ class RunEvent:
         return event
 
 
-@dataclass(frozen=True)
-class CaseVariant:
-    """How one case of a run differs from the version's defaults (`"simulation": {"cases"}`)."""
-
-    name: str
-    data: Mapping[str, Any]
-    actors: Mapping[str, str]  # pattern actor → who stands in for it
-
-
 _STAND_IN = re.compile(r"[A-Za-z0-9_-]{1,40}")
 
 
-def case_variants(document: Mapping[str, Any], pattern: Pattern) -> list[CaseVariant]:
-    """The document's `"simulation": {"cases": [...]}`; raises ValueError saying what is wrong."""
-    simulation = document.get("simulation", {})
-    cases = simulation.get("cases", []) if isinstance(simulation, Mapping) else None
-    if not isinstance(cases, list):
-        raise ValueError('"simulation" must be an object whose "cases" is a list.')
-    types = {actor.id: actor.type for actor in pattern.actors}
-    variants = []
-    for index, case in enumerate(cases, start=1):
-        where = f"simulation case {index}"
-        if not isinstance(case, Mapping):
-            raise ValueError(f"{where} must be an object.")
-        data, actors = case.get("data", {}), case.get("actors", {})
-        if not isinstance(data, Mapping):
-            raise ValueError(f"{where}: its data must be an object.")
-        if not isinstance(actors, Mapping):
-            raise ValueError(f"{where}: its actors must map actors to stand-ins.")
-        for actor, stand_in in actors.items():
-            if actor not in types:
-                raise ValueError(f"{where}: the pattern has no actor {actor!r}.")
+def case_variants(document: Mapping[str, Any], net: CaseNet) -> tuple[CaseVariant, ...]:
+    """The document's `"simulation": {"cases": [...]}` as the prediction reads them
+    (hrc.engine.prediction.case_variants, checked as `predict` checks them), each stand-in
+    also a name a simulated operator or gateway can take. Raises ValueError saying what is
+    wrong."""
+    variants = prediction.case_variants(document.get("simulation"), net)
+    for variant in variants:
+        for actor, stand_in in variant.actors.items():
             if not isinstance(stand_in, str) or not _STAND_IN.fullmatch(stand_in):
-                raise ValueError(f"{where}: {actor}'s stand-in must be a name of letters, digits, - or _.")  # fmt: skip
-            if types.get(stand_in, types[actor]) != types[actor]:
-                raise ValueError(f"{where}: {actor} and {stand_in} are not both {types[actor]}s.")
-        variants.append(CaseVariant(str(case.get("name") or where), dict(data), dict(actors)))
+                raise ValueError(f"{variant.name}: {actor}'s stand-in must be a name of letters, digits, - or _.")  # fmt: skip
+        # The prediction's own check (private to it today), so the two refuse alike.
+        prediction.check_variant(variant, net)
     return variants
 
 
@@ -160,6 +146,9 @@ class Simulation:
     # Timers' own scale, where the model's timers are far longer than its steps (hours).
     timer_scale: float | None = None
     operator_delay: tuple[float, float] = (0.2, 1.0)  # seconds, times time_scale
+    # An operator task's time by task id (seconds, times time_scale), drawn as the prediction
+    # draws it; a task not named here takes operator_delay. A cobot's step takes its program's.
+    durations: Mapping[str, Duration] = field(default_factory=dict)
     inline: bool = True
     seed: int | None = None
     # Whether the person at the pendant powers the cobots on before the run (a test of a
@@ -179,7 +168,7 @@ class Simulation:
         self._cobots: dict[str, Cobot] = {}
         self._devices: dict[str, Device] = {}
         self._with_devices = False
-        self._variants: list[CaseVariant] = []
+        self._variants: tuple[CaseVariant, ...] = ()
         self._started = 0
         self._answers: Counter[tuple[int, str]] = Counter()
 
@@ -210,7 +199,7 @@ class Simulation:
         )
         self.version = pattern_services.publish_pattern(pattern, published_by=engineer)
         net = case_net(self.version)
-        self._variants = case_variants(self.document, net.pattern)
+        self._variants = case_variants(self.document, net)
         stand_ins = {actor.id: actor.id for actor in net.pattern.actors}
         for variant in self._variants:
             # A new name stands in like the first actor it stands in for (its program).
@@ -411,13 +400,23 @@ class Simulation:
             with contextlib.suppress(Refusal):  # withdrawn or held meanwhile: try again later
                 if item.state == WorkItemState.OFFERED:
                     services.start_work_item(item, user=user)
-                    low, high = self.operator_delay
-                    due[item.pk] = now + self._random.uniform(low, high) * self.time_scale
+                    # From after the start's commit, not from `now`: the task's time counts
+                    # from its task-started event, stamped inside start_work_item.
+                    started = time.monotonic()
+                    due[item.pk] = started + self._operator_seconds(item.task) * self.time_scale
                 elif now >= due.setdefault(item.pk, now):
                     form = case_net(item.case.version).tasks[item.task].form
                     answer = self._answers[(item.case_id, item.task)]
-                    services.complete_work_item(item, user=user, data=example_for(form, answer))
+                    services.complete_work_item(item, user=user, data=example_answers(form, answer))
                     self._answers[(item.case_id, item.task)] += 1
+
+    def _operator_seconds(self, task: str) -> float:
+        """How long the operator takes over `task`, before the time scale."""
+        duration = self.durations.get(task)
+        if duration is not None:
+            return duration.sample(self._random)
+        low, high = self.operator_delay
+        return self._random.uniform(low, high)
 
     # Reporting ------------------------------------------------------------------------
 
@@ -444,36 +443,3 @@ class Simulation:
             RunEvent(seq, at.isoformat(), case, task, actor, kind, name)
             for seq, (at, case, task, actor, kind, name) in enumerate(events, start=1)
         ]
-
-
-def example_for(schema: Mapping[str, Any] | None, answer: int = 0) -> dict[str, Any]:
-    """Form data a simulated operator enters the `answer`-th time (from 0) it completes a task:
-    for each required field its examples in turn, else its default, first choice or a value
-    of its type (the module's docstring)."""
-    if not schema:
-        return {}
-    values: dict[str, Any] = {}
-    properties = schema.get("properties", {})
-    for name in schema.get("required", []):
-        values[name] = _example_value(properties.get(name, {}), answer)
-    return values
-
-
-def _example_value(schema: Mapping[str, Any], answer: int) -> Any:
-    examples = schema.get("examples")
-    if isinstance(examples, list) and examples:
-        return examples[answer % len(examples)]
-    if "enum" in schema:
-        return schema["enum"][0]
-    if "default" in schema:
-        return schema["default"]
-    kind = schema.get("type")
-    if kind == "boolean":
-        return True
-    if kind in ("integer", "number"):
-        return schema.get("minimum", 0)
-    if kind == "array":
-        return []
-    if kind == "object":
-        return example_for(schema, answer)
-    return "ok"

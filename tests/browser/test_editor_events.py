@@ -174,7 +174,11 @@ def test_the_token_game_cancels_a_running_task_and_a_step_back_resumes_it(
     expect(pattern_badge(page)).to_have_attribute("data-sound", "true", timeout=CHECKED)
     page.get_by_role("button", name="Token game").click()
     bar = page.get_by_role("toolbar", name="Token game")
+    # Each click once the game shows what the last one did: on a loaded machine a click that
+    # comes before the game is on, or before t1 has fired, fires nothing.
+    expect(bar.locator(".hrc-game-caption")).to_contain_text("Can fire: t1")
     click_element(page, "t1")
+    expect(page.locator('[data-element-id="p2"] .hrc-token')).to_have_count(1)
     click_element(page, "tc1")
     expect(_element(page, "tc1")).to_have_class(RUNNING)
 

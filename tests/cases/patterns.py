@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from typing import Any
 
 PROGRAM = "Coexistence_PickAndPlace"
@@ -260,3 +261,42 @@ def cool_down_then_inspect(timer: str = "PT10M") -> dict[str, Any]:
     ]
     arcs = [["p0", "cool_down"], ["cool_down", "p1"], ["p1", "to1"], ["to1", "p2"]]
     return _operators_only("Cool down, then inspect", _process(tasks, arcs, ["p0", "p1", "p2"]))
+
+
+def lanes_document(
+    lanes: list[list[str]], constraints: list[tuple[str, str, str]]
+) -> dict[str, Any]:
+    """One lane: its tasks in sequence; more: an AND split into the lanes and their join. A
+    task named tc… is the cobot's 2 s pick, to… the operator's."""
+    tasks: list[dict[str, Any]] = []
+    for task in itertools.chain(*lanes):
+        if task.startswith("tc"):
+            step = {"program": PROGRAM, "number": PICK}
+            tasks.append({"id": task, "performer": "c", "task": {"step": step, "timeout": 60}})
+        else:
+            tasks.append({"id": task, "performer": "o"})
+    places, arcs = ["p0", "p9"], []
+    if len(lanes) > 1:
+        tasks += [{"id": "split"}, {"id": "join"}]
+        arcs += [["p0", "split"], ["join", "p9"]]
+    for number, lane in enumerate(lanes):
+        inner = [f"l{number}p{i}" for i in range(len(lane) + 1)]
+        places += inner
+        first, last = ("split", "join") if len(lanes) > 1 else ("p0", "p9")
+        path = [first, *itertools.chain(*zip(inner, lane, strict=False)), inner[-1], last]
+        if len(lanes) == 1:  # p0 → task → … → p9: the lane's own places only between tasks
+            path = ["p0", *itertools.chain(*zip(lane, inner[1:], strict=False))]
+            path[-1] = "p9"
+            places = [p for p in places if p not in (inner[0], inner[-1])]
+        arcs += [[a, b] for a, b in itertools.pairwise(path)]
+    return {
+        "format": "hrc-pattern/1",
+        "name": "lanes",
+        "actors": [{"id": "c", "type": "cobot", "program": PROGRAM}, {"id": "o", "type": "operator"}],
+        "processes": [{
+            "id": "N", "workpiece": "w", "actors": ["c", "o"],
+            "places": [{"id": p, "tokens": 1 if p == "p0" else 0} for p in places],
+            "transitions": tasks, "arcs": arcs,
+        }],
+        "constraints": [{"from": a, "to": b, "type": kind} for a, b, kind in constraints],
+    }  # fmt: skip

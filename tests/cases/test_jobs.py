@@ -62,9 +62,10 @@ def test_an_operator_in_the_shared_area_pauses_the_running_cobot_until_done(
     simulation: Simulation,
 ) -> None:
     cobot = simulation.cobot("c")
-    # The pick slowed down until the pause: on a loaded machine the operator's start could
-    # otherwise come after a pick of ~1 s had ended (4 s now), and there would be nothing to pause.
-    cobot.call("Simulator/InjectFault", "slow-steps", "4")
+    # The pick slowed down until the pause: on a loaded machine the operator's start and the
+    # pause could otherwise come after a pick of ~1 s had ended (15 s now), and there would be
+    # nothing to pause. The move under way when the pause comes stays slow to its end.
+    cobot.call("Simulator/InjectFault", "slow-steps", "15")
     with simulation.running(operators=False):
         [case_id] = simulation.start_cases(1)
         case = Case.objects.get(pk=case_id)

@@ -1,11 +1,12 @@
 /**
  * The server, as the editor uses it: drafts, checks, layout, the execution
- * net, publishing, import and export (hrc/patterns/api), through the pages'
- * one HTTP client (shared/http.ts).
+ * net, predictions, publishing, import and export (hrc/patterns/api), through
+ * the pages' one HTTP client (shared/http.ts).
  */
 
 import { request, type Method } from "../shared/http";
 import type { PatternDocument } from "./model/document";
+import type { PredictionAnswer, PredictOptions } from "./model/prediction";
 
 export interface PatternRecord {
   id: number;
@@ -27,6 +28,22 @@ export interface CheckReport {
   sound: boolean | null;
   errors: CheckIssue[];
   warnings: CheckIssue[];
+}
+
+/** A published version as the versions' list gives it (hrc/patterns/api/serializers.py). */
+export interface VersionSummary {
+  id: number;
+  pattern: number;
+  number: number;
+  published_at: string;
+  retired_at: string | null;
+}
+
+export interface PredictRequest {
+  document: PatternDocument;
+  pattern?: number;
+  compare_version?: number;
+  options?: PredictOptions;
 }
 
 export class Api {
@@ -58,6 +75,17 @@ export class Api {
 
   executionNet(document: PatternDocument): Promise<unknown> {
     return this.request("POST", "/patterns/execution-net/", document);
+  }
+
+  /** Simulates many cases of the draft; with `compare_version`, that version too, with the same options. */
+  predict(body: PredictRequest): Promise<PredictionAnswer> {
+    return this.request("POST", "/patterns/predict/", body);
+  }
+
+  /** The pattern's published versions, the newest first. */
+  async versions(pattern: number): Promise<VersionSummary[]> {
+    const page = await this.request<{ results: VersionSummary[] }>("GET", `/pattern-versions/?pattern=${pattern}&limit=1000`);
+    return page.results;
   }
 
   /** Creates a pattern from a file's text; the server converts PNML and BPMN. */

@@ -35,6 +35,7 @@ import LanesModule from "./features/lanes";
 import LayoutModule from "./features/layout";
 import ModelingModule from "./features/modeling";
 import PaletteModule from "./features/palette";
+import PredictionModule from "./features/prediction";
 import PropertiesModule from "./features/properties";
 import RulesModule from "./features/rules";
 import TokenGameModule from "./features/token-game";
@@ -82,6 +83,7 @@ export const MODULES = [
   CopyModule,
   CheckingModule,
   TokenGameModule,
+  PredictionModule,
   PropertiesModule,
   FilesModule,
   LayoutModule,

@@ -2,12 +2,15 @@
 
 from typing import Any
 
+from drf_spectacular.utils import extend_schema_field
 from rest_framework import serializers
 
+from hrc.engine.durations import Duration, DurationError, duration_from_dict
 from hrc.engine.startdata import defaults_of, start_schema
 from hrc.organisations.api.serializers import MemberOrganisationField
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternModel, PatternVersion
+from hrc.patterns.prediction import MAX_CASES, MAX_PARALLEL, Options
 
 
 class PatternSummarySerializer(serializers.ModelSerializer[PatternModel]):
@@ -265,3 +268,76 @@ class ExecutionNetSerializer(serializers.Serializer[dict[str, Any]]):
         child=serializers.CharField(),
         help_text="Constraint places, which proper completion does not look at.",
     )
+
+
+@extend_schema_field(
+    {
+        "type": "object",
+        "properties": {
+            "kind": {"type": "string", "enum": ["fixed", "triangular", "lognormal", "empirical"]}
+        },
+        "required": ["kind"],
+        "description": "fixed: seconds; triangular: low, mode, high; lognormal: mu and "
+        "sigma, median and p90, or mean and sd; empirical: samples (seconds).",
+    }
+)
+class DurationField(serializers.Field):  # type: ignore[type-arg]
+    """A task's time: `{"kind": "fixed", "seconds": 3}`, triangular (low, mode, high) or
+    lognormal (mu and sigma, median and p90, or mean and sd); read by the engine."""
+
+    def to_internal_value(self, data: Any) -> Duration:
+        if not isinstance(data, dict):
+            raise serializers.ValidationError("A time is an object with a 'kind'.")
+        try:
+            return duration_from_dict(data)
+        except DurationError as exc:
+            raise serializers.ValidationError(str(exc)) from None
+
+    def to_representation(self, value: Duration) -> dict[str, Any]:
+        return value.as_dict()
+
+
+class PredictOptionsSerializer(serializers.Serializer[Any]):
+    cases = serializers.IntegerField(min_value=1, max_value=MAX_CASES, default=1000)
+    parallel = serializers.IntegerField(min_value=1, max_value=MAX_PARALLEL, default=1)
+    seed = serializers.IntegerField(min_value=0, max_value=2**63 - 1, default=0)
+    people = serializers.DictField(
+        child=serializers.IntegerField(min_value=1, max_value=MAX_PARALLEL),
+        default=dict,
+        help_text="Operator actor → persons in its team (1 when not given).",
+    )
+    durations = serializers.DictField(
+        child=DurationField(), default=dict, help_text="Task id → its time."
+    )
+    weights = serializers.DictField(
+        child=serializers.FloatField(min_value=0, max_value=1e9),
+        default=dict,
+        help_text="Transition id → its weight among the branches of its choice.",
+    )
+    measured = serializers.BooleanField(
+        default=True, help_text="Use measured times where no time is given."
+    )
+
+    def options(self) -> Options:
+        return Options(**self.validated_data)
+
+
+class PredictRequestSerializer(serializers.Serializer[Any]):
+    document = serializers.JSONField(help_text="The hrc-pattern/1 document to predict.")
+    pattern = serializers.IntegerField(
+        required=False,
+        min_value=1,
+        help_text="The pattern the draft belongs to: its earlier versions' cases give measured times.",
+    )
+    compare_version = serializers.IntegerField(
+        required=False, min_value=1, help_text="A published version predicted the same way."
+    )
+    options = PredictOptionsSerializer(required=False)
+
+
+class PredictionSerializer(serializers.Serializer[Any]):
+    """The answer of POST /patterns/predict/ (hrc.engine.prediction_report.Prediction's fields)."""
+
+    prediction = serializers.JSONField()
+    durations = serializers.JSONField(help_text="Task id → where its time came from.")
+    compared = serializers.JSONField(allow_null=True)

@@ -42,6 +42,7 @@ from hrc.api.parsers import (
     read_body,
 )
 from hrc.api.permissions import MembersReadWritersWrite, target_organisation
+from hrc.errors import NotFound
 from hrc.organisations.selectors import writable_organisations
 from hrc.patterns import services
 from hrc.patterns.api.serializers import (
@@ -52,6 +53,8 @@ from hrc.patterns.api.serializers import (
     PatternSummarySerializer,
     PatternVersionSerializer,
     PatternVersionSummarySerializer,
+    PredictionSerializer,
+    PredictRequestSerializer,
     PublishRefusedSerializer,
     StartRightsSerializer,
     SwitchSerializer,
@@ -70,6 +73,7 @@ from hrc.patterns.documents import (
     to_pnml,
 )
 from hrc.patterns.models import PatternModel, PatternVersion
+from hrc.patterns.prediction import Measured, Options, measured_for, predict_document
 from hrc.patterns.selectors import (
     patterns_visible_to,
     published_pattern_named,
@@ -332,6 +336,50 @@ class PatternViewSet(viewsets.ModelViewSet[PatternModel]):
             net = execution_net(request.data)
         return Response(net)
 
+    @extend_schema(
+        request=PredictRequestSerializer,
+        responses={
+            200: PredictionSerializer,
+            400: OpenApiResponse(
+                DocumentErrorSerializer,
+                description="Not a readable document, a structural rule broken (the issues), "
+                "or a bad option (`fields` names it).",
+            ),
+            404: OpenApiResponse(
+                description="The pattern or version is not in your organisations."
+            ),
+        },
+    )
+    @action(detail=False, methods=["post"])
+    def predict(self, request: Request) -> Response:
+        """Predicts the document by simulating many cases: cycle time, each actor's load and
+        waiting, the bottleneck and the typical case's critical path.
+
+        Task times are the options' `durations`, else the times measured in `pattern`'s
+        earlier versions' completed cases (by task id, else label), else the program's
+        simulated time for a cobot's or device's task, else a default; `durations` in the
+        answer says which, per task. With `compare_version`, that version is predicted the
+        same way, side by side. Nothing is stored.
+        """
+        body = PredictRequestSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        data = body.validated_data
+        options: Options = Options(**data.get("options", {}))
+        pattern = _editable(patterns_visible_to(request.user), request, data.get("pattern"))
+        version = _editable(
+            versions_visible_to(request.user), request, data.get("compare_version"), "pattern__"
+        )
+        organisation = pattern.organisation_id if pattern else _editing_organisation(request)
+        with engine_slot(organisation):
+            draft = predict_document(data["document"], options, _measured(pattern, options))
+            compared = None
+            if version is not None:
+                measured = _measured(version.pattern, options)
+                predicted = predict_document(version.document, options, measured, compared=True)
+                number = {"id": version.pk, "number": version.number, "pattern": version.pattern_id}
+                compared = {"version": number, **predicted.as_dict()}
+        return Response({**draft.as_dict(), "compared": compared})
+
 
 class PatternVersionViewSet(viewsets.ReadOnlyModelViewSet[PatternVersion]):
     """Published versions of your organisations' patterns. The document is immutable; engineers and
@@ -451,6 +499,23 @@ def _editing_organisation(request: Request) -> int:
     if organisation_id is None:
         raise PermissionDenied(EditorsOfPatterns.message)
     return organisation_id
+
+
+def _editable(objects: QuerySet[Any], request: Request, pk: int | None, path: str = "") -> Any:
+    """The pattern or version `pk` of an organisation where the user edits (their measurements
+    are for engineers and admins); None for no pk; NotFound outside them."""
+    if pk is None:
+        return None
+    found = objects.filter(
+        pk=pk, **{f"{path}organisation__in": writable_organisations(request.user)}
+    ).first()
+    if found is None:
+        raise NotFound("Not found.")
+    return found
+
+
+def _measured(pattern: PatternModel | None, options: Options) -> Measured | None:
+    return measured_for(pattern) if pattern is not None and options.measured else None
 
 
 def _user(request: Request) -> Any:

@@ -1,11 +1,13 @@
-"""`python manage.py run_pattern FILE [--cases N] --simulate [--time-scale F] --json`
+"""`python manage.py run_pattern FILE [--cases N] --simulate [--time-scale F] [--durations FILE] --json`
 
 Runs a pattern file end to end against simulated cobots (one OPC UA gateway
 process per cobot actor) with operators that complete their tasks by
 themselves, and prints one JSON event per line:
 {"seq", "at", "case", "task", "actor", "event"}. Exits 0 when every case completed.
 How simulated operators fill forms, and how a document's cases may differ
-(`"simulation": {"cases": [...]}`), is in hrc/cases/simulation.py.
+(`"simulation": {"cases": [...]}`), is in hrc/cases/simulation.py. `--durations` gives
+operator tasks' times as distributions, the prediction's (hrc.engine.durations): a JSON
+object of task id → {"kind": "triangular", "low": 20, "mode": 25, "high": 40} and the like.
 """
 
 from __future__ import annotations
@@ -26,6 +28,9 @@ from hrc.cases.simulation import Simulation, case_variants
 from hrc.database import ensure_migrated
 from hrc.engine.check import check_document
 from hrc.engine.document import FormatError, parse_json, read_pattern
+from hrc.engine.durations import Duration, DurationError, duration_from_dict
+from hrc.engine.model import Pattern
+from hrc.engine.runtime import CaseNet
 
 
 class Command(BaseCommand):
@@ -55,9 +60,18 @@ class Command(BaseCommand):
             help="inline: jobs run on threads here; celery: on workers started separately.",
         )  # fmt: skip
         parser.add_argument("--seed", type=int, default=None, help="Operators' random delays.")
+        parser.add_argument(
+            "--durations", type=Path, default=None,
+            help="JSON: operator task id → its time as a distribution ({\"kind\": \"fixed\", "
+            "\"seconds\": 20}, triangular, lognormal, empirical), simulated seconds; other "
+            "operator tasks take 0.2–1.0 s.",
+        )  # fmt: skip
 
     def handle(self, *args: Any, **options: Any) -> None:
         document = self._read(options["file"])
+        durations = {}
+        if options["durations"] is not None:
+            durations = _read_durations(options["durations"], read_pattern(document))
         if options["cases"] < 1:
             raise CommandError("--cases must be 1 or more.")
         if options["time_scale"] < 0:
@@ -74,6 +88,7 @@ class Command(BaseCommand):
                 document, Path(workdir), time_scale=options["time_scale"],
                 timer_scale=options["timer_scale"],
                 inline=options["workers"] == "inline", seed=options["seed"],
+                durations=durations,
             ) as simulation,
         ):  # fmt: skip
             events = simulation.run(options["cases"], timeout=options["timeout"])
@@ -103,10 +118,33 @@ class Command(BaseCommand):
             problems = "; ".join(f"{issue.code}: {issue.message}" for issue in report.errors)
             raise CommandError(f"{path} cannot run: {problems}")
         try:
-            case_variants(data, read_pattern(data))
+            case_variants(data, CaseNet(read_pattern(data)))
         except ValueError as error:
             raise CommandError(f"{path} cannot run: {error}") from None
         return data
+
+
+def _read_durations(path: Path, pattern: Pattern) -> dict[str, Duration]:
+    """Operator task id → its time, from a JSON file; CommandError saying what is wrong."""
+    try:
+        data = json.loads(path.read_bytes())
+    except OSError as error:
+        raise CommandError(f"Cannot read {path}: {error.strerror}.") from None
+    except ValueError as error:
+        raise CommandError(f"{path} is not JSON: {error}") from None
+    if not isinstance(data, dict):
+        raise CommandError(f"{path} must be an object of task id → time.")
+    durations = {}
+    for task, time in data.items():
+        transition = pattern.transition(task)
+        actor = pattern.actor(transition.performer) if transition and transition.performer else None
+        if actor is None or actor.type != "operator":
+            raise CommandError(f"{path}: {task!r} is not an operator's task of the pattern.")
+        try:
+            durations[task] = duration_from_dict(time if isinstance(time, dict) else {})
+        except DurationError as error:
+            raise CommandError(f"{path}: {task}: {error}") from None
+    return durations
 
 
 @contextmanager

@@ -1,16 +1,17 @@
-/** The toolbar above the canvas: name, undo/redo, save, publish, import, export, layout, token game. */
+/** The toolbar above the canvas: name, undo/redo, save, publish, import, export, layout, token game, predict. */
 
 import type CommandStack from "diagram-js/lib/command/CommandStack";
 import type EventBus from "diagram-js/lib/core/EventBus";
 import type Canvas from "diagram-js/lib/core/Canvas";
 
 import type AutoLayout from "../layout/AutoLayout";
+import type PredictPanel from "../prediction/PredictPanel";
 import type TokenGameMode from "../token-game/TokenGameMode";
 import type PatternFiles from "./PatternFiles";
 import type { ExportFormat, FilesMessage } from "./PatternFiles";
 
 export default class Toolbar {
-  static $inject = ["eventBus", "config.shell", "patternFiles", "commandStack", "autoLayout", "tokenGame", "config.pattern", "canvas"];
+  static $inject = ["eventBus", "config.shell", "patternFiles", "commandStack", "autoLayout", "tokenGame", "config.pattern", "canvas", "predictPanel"];
 
   constructor(
     eventBus: EventBus,
@@ -21,6 +22,7 @@ export default class Toolbar {
     tokenGame: TokenGameMode,
     pattern: { canWrite: boolean },
     canvas: Canvas,
+    predictPanel: PredictPanel,
   ) {
     const bar = shell.toolbar;
     const name = document.createElement("input");
@@ -60,6 +62,16 @@ export default class Toolbar {
     button("Show all", "Fit the whole drawing into view", () => eventBus.fire("editor.fit", {}));
     button("Layout", "Lay the model out in its actor lanes", () => autoLayout.layout().catch((error: Error) => show({ text: `Layout failed: ${error.message}`, kind: "error" })));
     button("Token game", "Play the model: fire tasks by click", () => tokenGame.start().catch((error: Error) => show({ text: `The token game could not start: ${error.message}`, kind: "error" })));
+    // Opens a panel and moves the focus into it, so not back to the drawing as the others do.
+    const predict = document.createElement("button");
+    predict.type = "button";
+    predict.textContent = "Predict";
+    predict.title = "Predict cycle time, utilisation and the bottleneck by simulating many cases";
+    predict.setAttribute("aria-controls", predictPanel.section.id);
+    predict.setAttribute("aria-expanded", "false");
+    predict.addEventListener("click", () => predictPanel.toggle());
+    eventBus.on("prediction.toggled", (event: { open: boolean }) => predict.setAttribute("aria-expanded", String(event.open)));
+    bar.appendChild(predict);
 
     const importLabel = document.createElement("label");
     importLabel.className = "button hrc-import";

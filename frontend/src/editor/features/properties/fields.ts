@@ -1,4 +1,4 @@
-/** Form controls for the properties panel: each commits on change and shows its own error. */
+/** Form controls for the editor's panels: each commits on change and shows its own error. */
 
 import { addElement } from "../../../shared/dom";
 
@@ -15,8 +15,11 @@ export interface FieldOptions {
 
 let fieldCount = 0;
 
-/** A labelled control; the hint and the error describe it without being part of its name. */
-function labelled(parent: HTMLElement, text: string, control: HTMLElement, hint?: string): HTMLElement {
+/**
+ * A labelled control in its `.hrc-field`; the hint and the error describe it without being
+ * part of its name. Returns the element the error goes in.
+ */
+export function labelled(parent: HTMLElement, text: string, control: HTMLElement, hint?: string): HTMLElement {
   fieldCount += 1;
   const id = `hrc-field-${fieldCount}`;
   const wrapper = addElement(parent, "div", "hrc-field");
@@ -49,6 +52,25 @@ export function field(parent: HTMLElement, options: FieldOptions): HTMLInputElem
   if (!options.commit) input.readOnly = true;
   else input.addEventListener("change", () => run(error, () => options.commit?.(input.value)));
   return input;
+}
+
+/** A number input whose value the caller reads and checks, saying what is wrong with `showError`; its bounds only guide the spinner. */
+export function numberField(parent: HTMLElement, label: string, value: string, bounds: { min: number; max?: number; step?: string }): HTMLInputElement {
+  const input = document.createElement("input");
+  input.type = "number";
+  input.min = String(bounds.min);
+  if (bounds.max !== undefined) input.max = String(bounds.max);
+  input.step = bounds.step ?? "1";
+  input.inputMode = input.step === "1" ? "numeric" : "decimal";
+  input.value = value;
+  labelled(parent, label, input);
+  return input;
+}
+
+/** Shows `message` as the field's error ("" clears it). */
+export function showError(control: HTMLElement, message: string): void {
+  const error = control.closest(".hrc-field")?.querySelector(".hrc-field-error");
+  if (error) error.textContent = message;
 }
 
 export function select(parent: HTMLElement, label: string, value: string, choices: [string, string][], commit?: (value: string) => void): HTMLSelectElement {

@@ -1,0 +1,104 @@
+"""The prediction (hrc.engine.prediction) against `run_pattern --simulate`: the same small
+patterns, given fixed times (the operators' through the simulation's `durations`, the cobots'
+from the simulator's programs at a time scale), give each case the same sequence of task
+starts and completions, run through the real Simulation (inline jobs, real OPC UA gateway
+processes) and predicted with the same times and the simulator's plant.
+
+Events the prediction puts at one instant (a completion and the starts it enables, an AND
+split's first tasks) happen at run time a few hops apart in an order nobody decides (a
+worker's lease against a tablet's poll), so they are compared as a set: the prediction's
+events are cut into instants, and the run's, in the order its log recorded them, into runs of
+the same lengths. However long the hops take on a busy machine, each instant's events must
+then come together, in the instant's place. The times are chosen so that the prediction's
+distinct instants are MIN_GAP or more apart (the test checks it first), far over the
+runtime's hops: the run's order then says what hrc did, not who won a race.
+"""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import pytest
+
+from hrc.cases.simulation import RunEvent, Simulation
+from hrc.engine import read_pattern
+from hrc.engine.durations import Fixed
+from hrc.engine.prediction import Scenario, predict
+from hrc.engine.prediction_report import TraceEvent
+from hrc.engine.runtime import CaseNet
+from hrc_gateway.sim.timing import SimulatedPlant
+from tests.cases.patterns import lanes_document
+
+pytestmark = pytest.mark.django_db(transaction=True)
+
+# Wall seconds per simulated second, for the cobots' programs and the operators alike: a 2 s
+# pick takes about 1 s.
+TIME_SCALE = 0.5
+# An operator's task: 1.4 s simulated, 0.7 s of wall time.
+OPERATOR_SECONDS = 1.4
+# The prediction's distinct instants at least this far apart (wall seconds; the hops between
+# a completion and what it starts are tens of milliseconds on a quiet machine).
+MIN_GAP = 0.3
+
+Instant = frozenset[tuple[str, str]]
+
+
+def _predicted_instants(trace: tuple[TraceEvent, ...], case: int) -> list[Instant]:
+    """The case's events by instant, in time order; fails if two instants lie too close."""
+    instants: dict[float, set[tuple[str, str]]] = {}
+    for event in trace:
+        if event.case == case:
+            instants.setdefault(event.at, set()).add((event.task, event.event))
+    times = sorted(instants)
+    gaps = [(b - a) * TIME_SCALE for a, b in itertools.pairwise(times)]
+    assert all(gap >= MIN_GAP for gap in gaps), f"instants too close to compare: {times}"
+    return [frozenset(instants[at]) for at in times]
+
+
+def _run_instants(events: list[RunEvent], case: int, sizes: list[int]) -> list[Instant]:
+    """The case's events in log order, cut into runs of `sizes` (the predicted instants')."""
+    names = {"task-started": "start", "task-completed": "complete"}
+    ran = [(e.task or "", names[e.event]) for e in events if e.case == case and e.event in names]
+    assert len(ran) == sum(sizes), ran
+    cuts = list(itertools.accumulate(sizes, initial=0))
+    return [frozenset(ran[start:end]) for start, end in itertools.pairwise(cuts)]
+
+
+@pytest.mark.parametrize(
+    ("lanes", "constraints", "cases"),
+    [
+        # The operator loads, the cobot picks, the operator unloads.
+        ([["to1", "tc1", "to2"]], [], 1),
+        # to1 waits for tc0 to complete, though its lane is free from the start.
+        ([["tc0", "tc1"], ["to1", "to2"]], [("tc0", "to1", "time")], 1),
+        # The cobot holds tc1's part until the operator's to2 on it is done.
+        ([["tc1"], ["to1", "to2"]], [("tc1", "to2", "func")], 1),
+        # to1 enters the area while tc0 runs: the cobot is paused until to1 is done.
+        ([["tc0", "tc1"], ["to0", "to1", "to2"]], [("tc0", "to1", "space")], 1),
+        # Two cases, one cobot: the second case's pick waits for the first's.
+        ([["tc0"], ["to0", "to1"]], [], 2),
+    ],
+    ids=["sequence", "time", "func", "space", "two-cases-one-cobot"],
+)
+def test_each_case_starts_and_completes_its_tasks_in_the_predicted_order(
+    tmp_path: Path, lanes: list[list[str]], constraints: list[tuple[str, str, str]], cases: int
+) -> None:
+    document = lanes_document(lanes, constraints)
+    operator_tasks = [task for task in itertools.chain(*lanes) if task.startswith("to")]
+    durations = {task: Fixed(OPERATOR_SECONDS) for task in operator_tasks}
+    scenario = Scenario(
+        cases=cases, parallel=cases, durations=durations, people={"o": None}, trace=True
+    )
+    predicted = predict(CaseNet(read_pattern(document)), scenario, plant=SimulatedPlant)
+    expected = [_predicted_instants(predicted.trace, index) for index in range(cases)]
+
+    with Simulation(document, tmp_path, time_scale=TIME_SCALE, durations=durations) as run:
+        events = run.run(cases, timeout=120)
+
+    started = sorted({event.case for event in events})
+    assert [e.event for e in events if e.event.startswith("case-")] == ["case-completed"] * cases
+    sizes = [[len(instant) for instant in instants] for instants in expected]
+    assert [
+        _run_instants(events, case, n) for case, n in zip(started, sizes, strict=True)
+    ] == expected
