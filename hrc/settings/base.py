@@ -113,9 +113,10 @@ if DATABASE_URL:
         # the pool has few connections, and one stuck query per request would drain it.
         timeout_ms = int(float(env_str("HRC_DB_STATEMENT_TIMEOUT") or 30) * 1000)
         options["options"] = f"-c statement_timeout={timeout_ms}"
-        # Parameters bound by the server, not quoted into the SQL text by Python: psycopg
-        # then prepares a statement a connection runs again and again (the hot path's), so
-        # neither the worker quotes nor PostgreSQL parses and plans it each time.
+        # Parameters bound by the server, not quoted into the SQL text by Python. Statements
+        # are not prepared (Django's default, prepare_threshold None): preparing the hot
+        # path's gained nothing measurable, and their generic plans doubled PostgreSQL's
+        # CPU per case (bench/README.md, "Prepared statements").
         options["server_side_binding"] = True
         options["pool"] = {
             "min_size": 1,
