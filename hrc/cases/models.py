@@ -149,7 +149,13 @@ class WorkItem(models.Model):
                 name="work_item_one_open_per_task",
             )
         ]
-        indexes = [models.Index(fields=["state", "kind"])]
+        indexes = [
+            models.Index(fields=["state", "kind"]),
+            # Whether another case's func hold reserves a job's cobot is asked per queued job
+            # (the sweeper's read, a lease's queue): through this, a few running items, not
+            # every item the cobot ever had (bench/README.md, "A cobot's running items").
+            models.Index(fields=["cobot", "state"]),
+        ]
 
     def __str__(self) -> str:
         return f"{self.label or self.task} ({self.state})"
