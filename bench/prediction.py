@@ -498,28 +498,13 @@ def _percent(value: float | None) -> str:
 def parse_args(argv: Sequence[str] | None = None) -> Settings:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--quick", action="store_true", help=f"a small run: {QUICK}")
-    parser.add_argument("--time-scale", type=float, help="robot time per wall second (default 0.1)")
-    parser.add_argument("--rounds", type=int, help="rounds per use case (default 5)")
-    parser.add_argument("--only", help="use cases by number or file stem, e.g. 2,5_polishing")
-    parser.add_argument("--results-dir", type=Path, default=RESULTS_DIR)
+    use_cases.add_run_options(parser, rounds=Settings.rounds)
     arguments = parser.parse_args(argv)
     settings = replace(Settings(), quick=arguments.quick, results_dir=arguments.results_dir)
     if arguments.quick:
         settings = replace(settings, **QUICK)
-    if arguments.time_scale is not None:
-        if not 0 < arguments.time_scale <= 1:
-            parser.error("--time-scale must be more than 0 and at most 1")
-        settings = replace(settings, time_scale=arguments.time_scale)
-    if arguments.rounds is not None:
-        if arguments.rounds < 1:
-            parser.error("--rounds must be at least 1")
-        settings = replace(settings, rounds=arguments.rounds)
-    if arguments.only:
-        only = tuple(part.strip() for part in arguments.only.split(",") if part.strip())
-        if len(use_case_files(only)) < len(only):
-            parser.error(f"--only names use cases that do not exist: {arguments.only}")
-        settings = replace(settings, only=only)
-    return settings
+    result: Settings = use_cases.apply_run_options(parser, arguments, settings, ("rounds",))
+    return result
 
 
 def main(argv: Sequence[str] | None = None) -> None:

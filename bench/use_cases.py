@@ -286,23 +286,27 @@ def print_table(report: Mapping[str, Any]) -> None:
     print_load(report)
 
 
-def parse_args(argv: Sequence[str] | None = None) -> Settings:
-    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help=f"a small run: {QUICK}")
+def add_run_options(parser: argparse.ArgumentParser, *, rounds: int) -> None:
+    """The options of a bench that runs the use cases (this one, bench.prediction)."""
     parser.add_argument("--time-scale", type=float, help="robot time per wall second (default 0.1)")
-    parser.add_argument("--rounds", type=int, help="rounds per use case (default 3)")
-    parser.add_argument("--workers", type=int, help=f"Celery workers (default {WORKERS})")
+    parser.add_argument("--rounds", type=int, help=f"rounds per use case (default {rounds})")
     parser.add_argument("--only", help="use cases by number or file stem, e.g. 2,5_polishing")
     parser.add_argument("--results-dir", type=Path, default=RESULTS_DIR)
-    arguments = parser.parse_args(argv)
-    settings = replace(Settings(), quick=arguments.quick, results_dir=arguments.results_dir)
-    if arguments.quick:
-        settings = replace(settings, **QUICK)
+
+
+def apply_run_options(
+    parser: argparse.ArgumentParser,
+    arguments: argparse.Namespace,
+    settings: Any,
+    counts: Sequence[str],
+) -> Any:
+    """`settings` (a bench's Settings) with add_run_options' options and the `counts` (options
+    of at least 1, such as rounds) given; a nonsense value ends the bench with its message."""
     if arguments.time_scale is not None:
         if not 0 < arguments.time_scale <= 1:
             parser.error("--time-scale must be more than 0 and at most 1")
         settings = replace(settings, time_scale=arguments.time_scale)
-    for name in ("rounds", "workers"):
+    for name in counts:
         value = getattr(arguments, name)
         if value is not None:
             if value < 1:
@@ -314,6 +318,19 @@ def parse_args(argv: Sequence[str] | None = None) -> Settings:
             parser.error(f"--only names use cases that do not exist: {arguments.only}")
         settings = replace(settings, only=only)
     return settings
+
+
+def parse_args(argv: Sequence[str] | None = None) -> Settings:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help=f"a small run: {QUICK}")
+    parser.add_argument("--workers", type=int, help=f"Celery workers (default {WORKERS})")
+    add_run_options(parser, rounds=Settings.rounds)
+    arguments = parser.parse_args(argv)
+    settings = replace(Settings(), quick=arguments.quick, results_dir=arguments.results_dir)
+    if arguments.quick:
+        settings = replace(settings, **QUICK)
+    result: Settings = apply_run_options(parser, arguments, settings, ("rounds", "workers"))
+    return result
 
 
 def main(argv: Sequence[str] | None = None) -> None:
