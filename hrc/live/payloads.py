@@ -15,7 +15,6 @@ from typing import Any, TypedDict
 
 from django.contrib.auth.models import User
 
-from hrc.cases.choices import JobState
 from hrc.cases.models import Case, WorkItem
 from hrc.cases.nets import compiled_net
 from hrc.cobots.models import CellStop
@@ -74,21 +73,6 @@ class IncidentRow(TypedDict):
     kind: str
     message: str
     resolution: str
-
-
-class JobRow(TypedDict):
-    """A queued or running job of a cobot, with its work item's task and label."""
-
-    cobot_id: int
-    state: str  # hrc.cases.choices.JobState
-    case_id: int
-    work_item_id: int
-    kind: str
-    attempt: int
-    waiting_for: str
-    command: Any
-    task: str
-    label: str
 
 
 class TimerRow(TypedDict):
@@ -225,27 +209,17 @@ def timer_data(row: TimerRow) -> TimerData:
     }
 
 
-def cobot_queue_data(cobot_id: int, jobs: list[JobRow], at: float) -> CobotQueueData:
-    """The cobot's queue from its queued and running jobs, in queue order."""
-    current: CurrentStep | None = None
-    waiting = ""
-    for job in jobs:
-        if job["state"] == JobState.RUNNING:
-            number = (job["command"] or {}).get("number")
-            current = {
-                "case": job["case_id"], "work_item": job["work_item_id"], "task": job["task"],
-                "label": job["label"], "kind": job["kind"],
-                "step": int(number) if isinstance(number, int) else None,
-                "attempt": job["attempt"],
-            }  # fmt: skip
-        elif not waiting and job["waiting_for"]:
-            waiting = job["waiting_for"]
+def cobot_queue_data(
+    cobot_id: int, length: int, current: CurrentStep | None, waiting: str | None, at: float
+) -> CobotQueueData:
+    """The cobot's queue: how many jobs it has (queued and running), the one it runs, and why its
+    first waiting job waits ("" when none says)."""
     return {
         "cobot": cobot_id,
         "at": at,
-        "queue_length": len(jobs),
+        "queue_length": length,
         "current": current,
-        "waiting_for": waiting,
+        "waiting_for": waiting or "",
     }
 
 

@@ -31,13 +31,14 @@ from hrc.live.events import (
     CellStopData,
     CobotData,
     CobotQueueData,
+    CurrentStep,
     FloorCobot,
     IncidentData,
     Snapshot,
     TimerData,
     WorkItemData,
 )
-from hrc.live.payloads import INCIDENT_FIELDS, TIMER_FIELDS, WORK_ITEM_FIELDS, JobRow
+from hrc.live.payloads import INCIDENT_FIELDS, TIMER_FIELDS, WORK_ITEM_FIELDS
 from hrc.organisations.models import Membership, Organisation, Team
 from hrc.organisations.selectors import AnyUser, cells_of
 
@@ -191,53 +192,67 @@ def cobot_queues(cobot_ids: list[int]) -> list[tuple[int, str, CobotQueueData]]:
     """(organisation, cell, queue) per cobot, in the order given: one statement whatever the count.
 
     Plain SQL: the sender runs it for every lease and finish, and the ORM's row building cost
-    more than the query itself.
+    more than the query itself. The database counts the queue and finds its running job and
+    first reason to wait: a row per cobot, however long its queue (1000 queued jobs read
+    row by row cost more than the cases' own statements; bench/README.md, "Cobot queues").
     """
     if not cobot_ids:
         return []
     marks = ", ".join(["%s"] * len(cobot_ids))
+    queued, running = JobState.QUEUED.value, JobState.RUNNING.value
     with connection.cursor() as cursor:
-        cursor.execute(_COBOT_QUEUES_SQL.format(marks=marks), [*_QUEUED_OR_RUNNING, *cobot_ids])
-        rows = cursor.fetchall()
-    cobots: dict[int, tuple[int, str]] = {}
-    by_cobot: dict[int, list[JobRow]] = {}
-    for cobot, organisation, cell, state, *job in rows:
-        cobots[cobot] = (organisation, cell)
-        if state is not None:
-            by_cobot.setdefault(cobot, []).append(_job_row(cobot, state, *job))
+        cursor.execute(
+            _COBOT_QUEUES_SQL.format(marks=marks), [queued, running, queued, running, *cobot_ids]
+        )
+        rows = {row[0]: row[1:] for row in cursor.fetchall()}
     at = payloads.now()
-    return [
-        (*cobots[pk], payloads.cobot_queue_data(pk, by_cobot.get(pk, []), at))
-        for pk in cobot_ids
-        if pk in cobots
-    ]
+    found = []
+    for pk in cobot_ids:
+        if pk not in rows:
+            continue
+        organisation, cell, length, waiting, *job = rows[pk]
+        current = _current_step(*job) if job[0] is not None else None
+        found.append(
+            (organisation, cell, payloads.cobot_queue_data(pk, length, current, waiting, at))
+        )
+    return found
 
 
-_QUEUED_OR_RUNNING = (JobState.QUEUED.value, JobState.RUNNING.value)
-# Each cobot with its queued and running jobs (none: one row of NULLs), in queue order. The
-# names formatted in are the models' tables; every value is a parameter.
+# Each cobot with the length of its queue (queued and running jobs), the first reason a queued
+# job gives for waiting, in queue order, and its running job, if any. Portable SQL (SQLite is
+# the embedded default). The names formatted in are the models' tables; every value is a
+# parameter.
+_JOB, _ITEM = Job._meta.db_table, WorkItem._meta.db_table
 _COBOT_QUEUES_SQL = f"""
-    SELECT c.id, c.organisation_id, c.cell, j.state, j.case_id, j.work_item_id, j.kind,
-           j.attempt, j.waiting_for, j.command, w.task, w.label
-    FROM {Cobot._meta.db_table} c
-    LEFT JOIN {Job._meta.db_table} j ON j.cobot_id = c.id AND j.state IN (%s, %s)
-    LEFT JOIN {WorkItem._meta.db_table} w ON w.id = j.work_item_id
-    WHERE c.id IN ({{marks}})
-    ORDER BY c.id, j.queued_at, j.id
+    SELECT c.id, c.organisation_id, c.cell, c.length, c.waiting,
+           r.case_id, r.work_item_id, r.kind, r.attempt, r.command, w.task, w.label
+    FROM (
+        SELECT c.id, c.organisation_id, c.cell,
+               (SELECT count(*) FROM {_JOB} q
+                WHERE q.cobot_id = c.id AND q.state IN (%s, %s)) AS length,
+               (SELECT q.waiting_for FROM {_JOB} q
+                WHERE q.cobot_id = c.id AND q.state = %s AND q.waiting_for <> ''
+                ORDER BY q.queued_at, q.id LIMIT 1) AS waiting,
+               (SELECT q.id FROM {_JOB} q WHERE q.cobot_id = c.id AND q.state = %s
+                ORDER BY q.queued_at DESC, q.id DESC LIMIT 1) AS running
+        FROM {Cobot._meta.db_table} c
+        WHERE c.id IN ({{marks}})
+    ) c
+    LEFT JOIN {_JOB} r ON r.id = c.running
+    LEFT JOIN {_ITEM} w ON w.id = r.work_item_id
 """
 
 
-def _job_row(
-    cobot: int, state: str, case: int, item: int, kind: str, attempt: int, waiting_for: str,
-    command: Any, task: str, label: str,
-) -> JobRow:  # fmt: skip
-    # A raw cursor hands JSON back as text; only a running job's step number is read from it.
-    if isinstance(command, str) and state == JobState.RUNNING:
+def _current_step(
+    case: int, item: int, kind: str, attempt: int, command: Any, task: str, label: str
+) -> CurrentStep:
+    """The running job of a cobot, and the program step number of its command."""
+    if isinstance(command, str):  # a raw cursor hands JSON back as text
         command = json.loads(command)
+    number = (command or {}).get("number")
     return {
-        "cobot_id": cobot, "state": state, "case_id": case, "work_item_id": item, "kind": kind,
-        "attempt": attempt, "waiting_for": waiting_for, "command": command, "task": task,
-        "label": label,
+        "case": case, "work_item": item, "task": task, "label": label, "kind": kind,
+        "step": int(number) if isinstance(number, int) else None, "attempt": attempt,
     }  # fmt: skip
 
 

@@ -57,6 +57,30 @@ def test_a_cobots_queue_counts_its_jobs_names_the_running_step_and_the_first_rea
     }  # fmt: skip
 
 
+def test_a_long_queue_is_read_as_one_row_per_cobot_with_a_reason_far_down_the_queue(
+    organisation: Organisation, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    version = factories.make_version(organisation, published_by=engineer)
+    cases = [
+        factories.hand_over_case(version, started_by=operator, operator=operator, cobot=cobot)
+        for _ in range(30)
+    ]
+    assert jobs.lease_next_job(cobot.pk) is not None
+    *_, last = Job.objects.filter(case__in=cases).order_by("queued_at", "id")
+    Job.objects.filter(pk=last.pk).update(waiting_for="the last one's reason")
+
+    with CaptureQueriesContext(connection) as captured:
+        [(_, _, queue)] = cobot_queues([cobot.pk])
+
+    assert (queue["queue_length"], queue["waiting_for"]) == (30, "the last one's reason")
+    assert queue["current"] is not None
+    assert queue["current"]["case"] == cases[0].pk
+    [statement] = captured.captured_queries
+    with connection.cursor() as cursor:  # the database counts: a row per cobot comes back
+        cursor.execute(statement["sql"])
+        assert len(cursor.fetchall()) == 1
+
+
 def test_a_cobots_queue_says_what_another_cases_func_hold_waits_for(
     organisation: Organisation, engineer: User, operator: User, cobot: Cobot
 ) -> None:
