@@ -628,9 +628,10 @@ def _first_due_per_cobot(now: dt.datetime) -> list[int]:
     """The first due job of each queue (a cobot's, a device's) that has nothing running,
     leaving out the jobs another case's func hold keeps waiting (the holding case's own may go).
 
-    One statement, which looks at the head of each queue only: the sweeper runs every few
-    seconds however long the queues have grown (numbering every queued job to find each
-    queue's first took 13 ms at 1000 queued; bench/README.md, "Cobot queues").
+    One statement that asks each queue for its head, a row per queue: the sweeper runs every
+    few seconds however long the queues have grown (numbering every queued job to find each
+    queue's first took 13 ms at 1000 queued; the database still sorts each queue's due jobs:
+    bench/README.md, "Cobot queues").
     """
     running = Job.objects.filter(state=JobState.RUNNING)
     due = Job.objects.filter(
