@@ -35,11 +35,15 @@ pytestmark = pytest.mark.django_db(transaction=True)
 # Wall seconds per simulated second, for the cobots' programs and the operators alike: a 2 s
 # pick takes about 1 s.
 TIME_SCALE = 0.5
-# An operator's task: 1.4 s simulated, 0.7 s of wall time.
-OPERATOR_SECONDS = 1.4
-# The prediction's distinct instants at least this far apart (wall seconds; the hops between
-# a completion and what it starts are tens of milliseconds on a quiet machine).
-MIN_GAP = 0.3
+# An operator's task: 4 s simulated, 2 s of wall time. With it every pattern's distinct
+# instants lie 1 s of wall time apart or more (with 1.4 s some lay 0.3 s apart).
+OPERATOR_SECONDS = 4.0
+# The prediction's distinct instants at least this far apart (wall seconds). The hops between
+# a completion and what it starts are tens of milliseconds on a quiet machine, but under the
+# test suite's load (two test processes, their gateways and workers) an operator's task once
+# started more than 0.3 s after the completion that enabled it, and the run's order then said
+# who won a race.
+MIN_GAP = 0.9
 
 Instant = frozenset[tuple[str, str]]
 
