@@ -2,7 +2,11 @@
 
 The handshake registers are watched through one subscription (publishing
 interval 0 by default: the gateway pushes every change at once), never
-polled. A step's data and its handshake bit go out in one write request. The
+polled. A session that has not driven a step for QUIET_SECONDS listens to the
+heartbeat alone (its other monitored items disabled) and to everything again,
+reading the cobot once, before its next step: every worker has a session to every
+cobot it ever drove, and each would otherwise be sent every change of every step
+the others drive. A step's data and its handshake bit go out in one write request. The
 fencing token makes every call safe to repeat: before sending, the driver
 looks at what the cobot already holds —
 - its output token is ours: the step ran; finish the handshake, send nothing;
@@ -79,6 +83,10 @@ STATE_PATHS = (
 WATCHED = (IN_BIT, *IN_FENCE, OUT_BIT, *OUT_FENCE, OUT_OUTCOME, *STATE_PATHS, urua.STATE_HEARTBEAT)
 # A gateway not heard from for this long (several heartbeats) is taken for dead.
 SILENCE_SECONDS = 8 * urua.HEARTBEAT_SECONDS
+# A session that drove no step for this long stops listening until its next step. Longer than
+# the gap between a cobot's steps in a busy chain (a worker drives a cobot's queue for
+# HRC_CHAIN_SECONDS), far shorter than the seconds an operator's task takes between two steps.
+QUIET_SECONDS = 0.25
 
 # Status codes that mean the request itself was wrong, not the cobot's state.
 _INVALID = frozenset(
@@ -153,6 +161,13 @@ class OpcUaDriver(CobotDriver):
         self._paths: dict[ua.NodeId, str] = {}
         self.cache: dict[str, Any] = {}
         self._changed = asyncio.Event()
+        # The subscription's items but the heartbeat's (by the gateway's handles), and whether
+        # they report: not from QUIET_SECONDS after the last step until the next one.
+        self._subscription_id = 0
+        self._step_items: list[int] = []
+        self._listening = False
+        self._quiet: asyncio.TimerHandle | None = None
+        self._falling_quiet: asyncio.Task[None] | None = None
         self._step_lock = asyncio.Lock()
         self._discarding: asyncio.Task[None] | None = None
         self._heard_at = 0.0
@@ -170,6 +185,7 @@ class OpcUaDriver(CobotDriver):
         await self._ensure_session(self._deadline(timeout or self.connect_timeout))
 
     async def close(self) -> None:
+        self._cancel_quiet()
         client, self._client, self._alive = self._client, None, False
         if client is not None:
             try:
@@ -318,9 +334,73 @@ class OpcUaDriver(CobotDriver):
             PublishingEnabled=True,
         )
         subscription = await client.create_subscription(parameters, _Handler(self))
-        await subscription.subscribe_data_change(
+        handles = await subscription.subscribe_data_change(
             list(self._nodes.values()), queuesize=16, sampling_interval=0
         )
+        self._step_items = [
+            handle
+            for path, handle in zip(self._nodes, handles, strict=True)
+            if path != urua.STATE_HEARTBEAT and isinstance(handle, int)
+        ]
+        self._subscription_id, self._listening = subscription.subscription_id, True
+
+    def _cancel_quiet(self) -> None:
+        if self._quiet is not None:
+            self._quiet.cancel()
+            self._quiet = None
+
+    def _fall_quiet_later(self) -> None:
+        self._cancel_quiet()
+        self._quiet = asyncio.get_running_loop().call_later(QUIET_SECONDS, self._fall_quiet_now)
+
+    def _fall_quiet_now(self) -> None:
+        self._quiet = None
+        self._falling_quiet = asyncio.get_running_loop().create_task(self._stop_listening())
+
+    async def _stop_listening(self) -> None:
+        """Disables every item but the heartbeat's until _listen. The heartbeat goes on: asyncua
+        recreates a subscription that has published nothing for a second. The cache goes stale
+        meanwhile, so a cheap state() reads again."""
+        if self._step_lock.locked():
+            return  # a step began meanwhile; it arms the timer again when it ends
+        async with self._step_lock:
+            if not (self._alive and self._listening):
+                return
+            self._listening, self._cache_behind = False, True
+            try:
+                await self._monitor(ua.MonitoringMode.Disabled)
+            except _CONNECTION_ERRORS as error:  # the next step finds out and reconnects
+                logger.debug("%s: could not stop listening: %s", self.name, _describe(error))
+
+    async def _listen(self) -> None:
+        """Enables the items again and reads every watched node, in one round trip: the gateway
+        sends the changes from now on, the read what happened while quiet. Items the gateway
+        no longer knows (asyncua recreated a stale subscription) mean a new session."""
+        if self._client is None:
+            raise _SessionLost("no session")
+        try:
+            statuses, values = await asyncio.gather(
+                self._monitor(ua.MonitoringMode.Reporting),
+                self._client.read_values(list(self._nodes.values())),
+            )
+        except _CONNECTION_ERRORS as error:
+            raise self._lost(error) from None
+        if not all(status.is_good() for status in statuses):
+            self._mark_lost(ConnectionError("the gateway no longer knows the subscription"))
+            raise _SessionLost("the gateway no longer knows the subscription")
+        self.cache.update(zip(self._nodes, values, strict=True))
+        self._listening, self._cache_behind = True, False
+        self._heard_at = time.monotonic()
+
+    async def _monitor(self, mode: ua.MonitoringMode) -> list[ua.StatusCode]:
+        if self._client is None:
+            raise ConnectionError("no session")
+        parameters = ua.SetMonitoringModeParameters()
+        parameters.SubscriptionId = self._subscription_id
+        parameters.MonitoredItemIds = self._step_items
+        parameters.MonitoringMode = mode
+        statuses: list[ua.StatusCode] = await self._client.uaclient.set_monitoring_mode(parameters)
+        return statuses
 
     async def _on_connection_lost(self, error: Exception) -> None:
         self._mark_lost(error)
@@ -370,21 +450,35 @@ class OpcUaDriver(CobotDriver):
         # Whether any pass sent the step: a session lost after sending leads to a
         # pass that finds the step done and sends nothing.
         sent: list[bool] = []
+        self._cancel_quiet()
         async with self._step_lock:
-            while True:
-                try:
-                    result = await self._drive(command, deadline, started, sent, on_sent)
-                    return dataclasses.replace(result, sent=result.sent or bool(sent))
-                except _SessionLost as lost:
-                    logger.info(
-                        "%s: session lost during step %s (%s)", self.name, command.fence, lost
-                    )
-                    if time.monotonic() >= deadline:
-                        raise StepTimeout(
-                            f"{self.name}: lost the gateway during step {command.fence} and it did "
-                            "not come back in time; the step is in doubt.",
-                            state=self.cache,
-                        ) from None
+            try:
+                return await self._run_step(command, deadline, started, sent, on_sent)
+            finally:
+                self._fall_quiet_later()
+
+    async def _run_step(
+        self,
+        command: StepCommand,
+        deadline: float,
+        started: float,
+        sent: list[bool],
+        on_sent: Callable[[], None] | None,
+    ) -> StepResult:
+        """run_step's passes, under the step lock: a session lost mid-step is reopened and
+        the step looked at again until the deadline."""
+        while True:
+            try:
+                result = await self._drive(command, deadline, started, sent, on_sent)
+                return dataclasses.replace(result, sent=result.sent or bool(sent))
+            except _SessionLost as lost:
+                logger.info("%s: session lost during step %s (%s)", self.name, command.fence, lost)
+                if time.monotonic() >= deadline:
+                    raise StepTimeout(
+                        f"{self.name}: lost the gateway during step {command.fence} and it did "
+                        "not come back in time; the step is in doubt.",
+                        state=self.cache,
+                    ) from None
 
     async def _drive(
         self,
@@ -395,6 +489,8 @@ class OpcUaDriver(CobotDriver):
         on_sent: Callable[[], None] | None,
     ) -> StepResult:
         await self._ensure_session(deadline)
+        if not self._listening:
+            await self._listen()
         if self._cache_behind or not self._ready_and_idle():
             # Before deciding on anything unusual, one read request: the subscription
             # may not yet have brought the effect of a command this client has just

@@ -10,6 +10,7 @@ from asyncua import Client, ua
 
 from hrc.cobots.drivers.base import (
     CobotNotReady,
+    CobotPaused,
     CobotStopped,
     CobotUnreachable,
     CommandRefused,
@@ -19,7 +20,7 @@ from hrc.cobots.drivers.base import (
     StepTimeout,
     unreachable_message,
 )
-from hrc.cobots.drivers.opcua.driver import OpcUaDriver
+from hrc.cobots.drivers.opcua.driver import QUIET_SECONDS, OpcUaDriver
 from hrc.cobots.simulated import GatewayProcess, free_port
 from hrc_gateway import urua
 from tests.cobots.simulator import executions, read
@@ -217,3 +218,31 @@ async def test_a_cached_state_follows_what_others_do_to_the_cobot(
 
     await until_async(lambda: driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_PAUSED)
     assert (await driver.state(fresh=False))["ProgramState"] == urua.PROGRAM_PAUSED
+
+
+async def test_a_quiet_session_hears_the_heartbeat_alone_and_reads_before_its_next_step(
+    driver: OpcUaDriver, observer: Client
+) -> None:
+    await driver.run_step(StepCommand(step=HOME, fence=Fence(19, 1)))
+    await asyncio.sleep(QUIET_SECONDS + 0.5)
+
+    # Another client pauses the program: the quiet session hears the heartbeat, not that.
+    cobot = observer.get_node(urua.node_id("cobot1"))
+    await cobot.call_method(ua.NodeId.from_string(urua.node_id("cobot1", "PauseProgram")))
+    beat = driver.cache[urua.STATE_HEARTBEAT]
+    await until_async(lambda: driver.cache[urua.STATE_HEARTBEAT] > beat + 2)
+    assert await read(observer, urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PAUSED
+    assert driver.cache[urua.STATE_PROGRAM_STATE] == urua.PROGRAM_PLAYING
+
+    # What it did not hear is read before anything is decided or sent.
+    assert (await driver.state(fresh=False))["ProgramState"] == urua.PROGRAM_PAUSED
+    with pytest.raises(CobotPaused):
+        await driver.run_step(StepCommand(step=PICK, fence=Fence(20, 1)))
+    assert await executions(observer) == 1
+
+    # Its next step listens again: the acknowledgement it waits for comes by the subscription.
+    await asyncio.sleep(QUIET_SECONDS + 0.5)
+    await driver.call("StartProgram")
+    result = await driver.run_step(StepCommand(step=PICK, fence=Fence(20, 1)))
+    assert (result.outcome, result.sent) == ("ran", True)
+    assert await executions(observer) == 2
