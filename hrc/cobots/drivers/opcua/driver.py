@@ -2,13 +2,14 @@
 
 The handshake registers are watched through one subscription (publishing
 interval 0 by default: the gateway pushes every change at once), never
-polled. A session that has not driven a step for QUIET_SECONDS listens to the
-heartbeat alone (its other monitored items disabled) and to everything again,
-reading the cobot once, before its next step: every worker has a session to every
-cobot it ever drove, and each would otherwise be sent every change of every step
-the others drive. A step's data and its handshake bit go out in one write request. The
-fencing token makes every call safe to repeat: before sending, the driver
-looks at what the cobot already holds —
+polled. A session that has driven no step for QUIET_SECONDS listens to the
+heartbeat alone (its other monitored items disabled), and to everything again,
+reading the cobot once, before its next step: every worker has a session to
+every cobot it ever drove, and each would otherwise be sent every change of
+every step the others drive (bench/README.md, "Quiet sessions"). A step's data
+and its handshake bit go out in one write request. The fencing token makes
+every call safe to repeat: before sending, the driver looks at what the cobot
+already holds —
 - its output token is ours: the step ran; finish the handshake, send nothing;
 - its input token is ours with the bit up: the step is in flight; wait for it;
 - anything else: finish any stale handshake, check the cobot can move, send.
