@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import signal
 import time
 
 import pytest
@@ -246,3 +247,21 @@ async def test_a_quiet_session_hears_the_heartbeat_alone_and_reads_before_its_ne
     result = await driver.run_step(StepCommand(step=PICK, fence=Fence(20, 1)))
     assert (result.outcome, result.sent) == ("ran", True)
     assert await executions(observer) == 2
+
+
+async def test_a_quiet_session_whose_gateway_froze_drives_its_next_step_once(
+    driver: OpcUaDriver, gateway: GatewayProcess
+) -> None:
+    await driver.run_step(StepCommand(step=HOME, fence=Fence(21, 1)))
+    await asyncio.sleep(QUIET_SECONDS + 0.5)
+    # Frozen past the heartbeat's silence: asyncua's checks give up on the subscription or on
+    # the connection, and the quiet session's next step finds out and opens a new one.
+    assert gateway.process is not None
+    gateway.process.send_signal(signal.SIGSTOP)
+    await asyncio.sleep(2.0)
+    gateway.process.send_signal(signal.SIGCONT)
+
+    result = await driver.run_step(StepCommand(step=PICK, fence=Fence(22, 1)))
+    assert (result.outcome, result.sent) == ("ran", True)
+    ran = await driver.read("Simulator/ExecutedSteps")
+    assert [line.split()[0] for line in ran] == ["21.1", "22.1"]
