@@ -98,7 +98,7 @@ TWO_LANES = [["tc0", "tc1"], ["to0", "to1", "to2"]]
         ([["tc0"], ["to0", "to1"]], [], 2, {}, TIME_SCALE),
         # Two cases, one cobot, and the first's func hold keeps the second's pick waiting.
         (TWO_LANES, TIME_AND_FUNC, 2, {}, TIME_SCALE),
-        # Two cases, one cobot: each case's to1 pauses the cobot only for its own tc0.
+        # Two cases, one cobot: the first case's to1 pauses its tc0; the second's waits behind.
         (TWO_LANES, SPACE, 2, SPACE_SECONDS, SPACE_TIME_SCALE),
     ],
     ids=[
