@@ -380,18 +380,15 @@ class OpcUaDriver(CobotDriver):
         if self._client is None:
             raise _SessionLost("no session")
         try:
-            statuses, values = await asyncio.gather(
-                self._monitor(ua.MonitoringMode.Reporting),
-                self._client.read_values(list(self._nodes.values())),
+            statuses, _ = await asyncio.gather(
+                self._monitor(ua.MonitoringMode.Reporting), self._refresh()
             )
         except _CONNECTION_ERRORS as error:
             raise self._lost(error) from None
         if not all(status.is_good() for status in statuses):
             self._mark_lost(ConnectionError("the gateway no longer knows the subscription"))
             raise _SessionLost("the gateway no longer knows the subscription")
-        self.cache.update(zip(self._nodes, values, strict=True))
-        self._listening, self._cache_behind = True, False
-        self._heard_at = time.monotonic()
+        self._listening, self._heard_at = True, time.monotonic()
 
     async def _monitor(self, mode: ua.MonitoringMode) -> list[ua.StatusCode]:
         if self._client is None:
