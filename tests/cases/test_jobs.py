@@ -20,6 +20,8 @@ from tests.support.polling import until
 
 pytestmark = pytest.mark.django_db(transaction=True)
 
+STEP_HANDED_OVER = urua.register_path("Inputs", urua.HANDSHAKE_BIT)
+
 
 def _operator_task(case: Case, task: str) -> WorkItem:
     item: WorkItem = until(
@@ -70,7 +72,9 @@ def test_an_operator_in_the_shared_area_pauses_the_running_cobot_until_done(
         [case_id] = simulation.start_cases(1)
         case = Case.objects.get(pk=case_id)
         services.complete_work_item(_do(simulation, case, "to1"), user=simulation.users["o"])
-        until(lambda: Job.objects.filter(case=case, state=JobState.RUNNING).exists())
+        # The step handed over, not only leased: an operator who enters while the worker still
+        # prepares the cobot holds the step back (jobs._prepare), and there is nothing to pause.
+        until(lambda: cobot.read(STEP_HANDED_OVER))
         inspect = _do(simulation, case, "to2")
         until(lambda: cobot.read(urua.STATE_PROGRAM_STATE) == urua.PROGRAM_PAUSED)
         cobot.call("Simulator/ClearFault")
