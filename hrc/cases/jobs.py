@@ -28,7 +28,7 @@ import logging
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 from django.conf import settings
 from django.db import transaction
@@ -290,13 +290,21 @@ def _lease_if_ready(
 
 
 def lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
-    """Both rows locked, in the project's lock order (case, then job); the work item read along."""
-    case = progress.lock_case(case_id)
-    where = f"{rows.table(Job)}.id = %s"
-    job = rows.fetch_one_with(Job, "work_item", where, [job_id], lock="FOR NO KEY UPDATE")
-    if job is None:
-        raise Job.DoesNotExist(f"There is no job {job_id}.")
-    return case, job
+    """Both rows locked, in the project's lock order (case, then job), and the job's work item
+    with them, in one statement. The work item is locked too, so that all three are read as
+    they are once the locks are held: a locked row is read in its newest committed version,
+    another row as the statement found it before any wait (READ COMMITTED)."""
+    case, job, item = (rows.table(model) for model in (Case, Job, WorkItem))
+    where = (
+        f"{case}.id = %s AND {job}.id = %s AND {job}.case_id = {case}.id "
+        f"AND {item}.id = {job}.work_item_id"
+    )
+    found = rows.fetch_each((Case, Job, WorkItem), where, [case_id, job_id], lock="FOR NO KEY UPDATE")  # fmt: skip
+    if found is None:
+        raise Job.DoesNotExist(f"There is no job {job_id} in case {case_id}.")
+    locked_case, locked_job, locked_item = cast(tuple[Case, Job, WorkItem], found)
+    locked_job.work_item = locked_item
+    return locked_case, locked_job
 
 
 def record_waiting(job: Job, waiting: str) -> bool:

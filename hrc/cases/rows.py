@@ -80,6 +80,29 @@ def fetch_one_with(
     return instance
 
 
+def fetch_each(
+    models: Sequence[type[Model]], where: str, params: Sequence[Any], *, lock: str = ""
+) -> tuple[Model, ...] | None:
+    """One row of each of `models`, read in one statement: `where` joins their tables and
+    narrows each to one row; None when there is no such row. `lock` locks every row, in the
+    order of `models` (PostgreSQL takes a statement's row locks table by table, in FROM
+    order), and then reads each as its newest committed version, even after waiting."""
+    selected = ", ".join(_columns(model, connection.vendor)[0] for model in models)
+    suffix = f" {lock}" if lock and connection.features.has_select_for_update else ""
+    sql = f"SELECT {selected} FROM {', '.join(table(model) for model in models)} WHERE {where}{suffix}"
+    with connection.cursor() as cursor:
+        cursor.execute(sql, list(params))
+        row = cursor.fetchone()
+    if row is None:
+        return None
+    found, start = [], 0
+    for model in models:
+        width = len(model._meta.concrete_fields)
+        found.append(_instance(model, row[start : start + width]))
+        start += width
+    return tuple(found)
+
+
 def update(instance: Model, fields: Sequence[str]) -> int:
     """UPDATE of the instance's row: these fields, by its primary key; the rows changed."""
     model = type(instance)

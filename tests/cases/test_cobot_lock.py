@@ -21,10 +21,10 @@ from django.db import connection, connections, transaction
 from django.test.utils import CaptureQueriesContext
 from django.utils import timezone
 
-from hrc.cases import jobs
+from hrc.cases import jobs, progress
 from hrc.cases import services as case_services
-from hrc.cases.choices import JobState
-from hrc.cases.models import Case, Job
+from hrc.cases.choices import JobState, WorkItemState
+from hrc.cases.models import Case, Job, WorkItem
 from hrc.celery import app
 from hrc.cobots.choices import CommandOutcome, ControlCommand
 from hrc.cobots.models import Cobot, CobotCommand
@@ -211,3 +211,48 @@ def test_the_sweeper_rings_each_cobots_first_due_job_in_one_read_however_long_th
         assert jobs._first_due_per_cobot(timezone.now()) == [first_due.pk]
 
     assert len(queries) == 1
+
+
+@pytest.mark.django_db(transaction=True)
+def test_a_lock_that_waited_for_the_case_reads_its_job_and_work_item_as_left_by_the_holder(
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
+) -> None:
+    # One statement locks the case, the job and its work item (jobs.lock_case_and_job): begun
+    # before the wait, it must still read what the holder of the case's lock committed.
+    cobot = _jobs_queued_on_a_cobot(organisation, engineer, operator, "alone", 1)
+    job = Job.objects.get(cobot=cobot)
+    locked = threading.Event()
+    release = threading.Event()
+    results: dict[str, Any] = {}
+
+    def holder() -> None:
+        try:
+            with transaction.atomic():
+                progress.lock_case(job.case_id)
+                WorkItem.objects.filter(pk=job.work_item_id).update(state=WorkItemState.CANCELLED)
+                Job.objects.filter(pk=job.pk).update(waiting_for="cancelled meanwhile")
+                locked.set()
+                release.wait(30)
+        finally:
+            connections.close_all()
+
+    def reader() -> None:
+        try:
+            with transaction.atomic():
+                results["read"] = jobs.lock_case_and_job(job.case_id, job.pk)
+        finally:
+            connections.close_all()
+
+    holding = threading.Thread(target=holder)
+    holding.start()
+    assert locked.wait(30)
+    reading = threading.Thread(target=reader)
+    reading.start()
+    until(_waiting_for_a_lock, 30, 0.01, "the lock never waited for the case")
+    release.set()
+    holding.join(30)
+    reading.join(30)
+
+    _, read = results["read"]
+    assert read.waiting_for == "cancelled meanwhile"
+    assert read.work_item.state == WorkItemState.CANCELLED

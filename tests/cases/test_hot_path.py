@@ -224,10 +224,11 @@ def test_the_finish_runs_a_fixed_number_of_statements(
     with sent_tasks(), counted() as statements:
         jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0})
     assert Case.objects.get(pk=item.case_id).status == CaseStatus.COMPLETED
-    # The case's lock, the job and its item, the item's completion, the open items, then the
-    # log, the job and the case in one statement; after the commit, whether the cobot has a
-    # job queued (a worker that leases the next job itself asks nothing: ring=False).
-    assert len(statements.sent) == 6, statements.sent
+    # The case, the job and its item locked in one statement, the item's completion, the open
+    # items, then the log, the job and the case in one statement; after the commit, whether
+    # the cobot has a job queued (a worker that leases the next job itself asks nothing:
+    # ring=False).
+    assert len(statements.sent) == 5, statements.sent
 
 
 def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
@@ -239,9 +240,9 @@ def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
         lease = jobs._lease_next("id = %s", cobot.pk)  # what a doorbell runs (run_next_job)
     assert lease is not None
     assert lease.job_id == _job(item).pk
-    # The cobot's lock, its queue, the case's lock, the job and its item, the step's start,
-    # the open items, then the log, the lease and the case in one statement.
-    assert len(statements.sent) == 7, statements.sent
+    # The cobot's lock, its queue, the case, the job and its item locked in one statement, the
+    # step's start, the open items, then the log, the lease and the case in one statement.
+    assert len(statements.sent) == 6, statements.sent
 
 
 def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_hand_it_over(
