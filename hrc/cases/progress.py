@@ -439,7 +439,15 @@ def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
     """
     start_task(case, net, item, None)
     rows.update(item, ["state", "started_at"])
-    advance(case, net)
+    advance_after_start(case, net, item.task)
+
+
+def advance_after_start(case: Case, net: CaseNet, task: str) -> None:
+    """advance, after `task` has started, unless its start can change nothing else (the net's
+    starts_alone: the work items already match the marking, and no other transition's
+    enabling moved); that saves a hot path's start the read of the open work items."""
+    if task not in net.starts_alone:
+        advance(case, net)
 
 
 def lease_job(case: Case, net: CaseNet, job: Job, now: dt.datetime, *, held_by: str) -> None:

@@ -259,7 +259,7 @@ def _start_operator_task(case: Case, net: CaseNet, item: WorkItem, user: User) -
         raise Conflict(str(refused)) from None
     item.claimed_by = user
     item.save(update_fields=["state", "started_at", "claimed_by"])
-    progress.advance(case, net)
+    progress.advance_after_start(case, net, item.task)
     case.save()
 
 

@@ -172,6 +172,20 @@ class CaseNet:
             for task in self.tasks
             if any(place in self._needs for place, _ in self._transitions[f"complete:{task}"].pre)
         )
+        # Tasks whose start touches no place another transition takes from: starting one
+        # enables, disables or rings nothing else, so nothing follows from it.
+        self.starts_alone = frozenset(task for task in self.tasks if self._starts_alone(task))
+
+    def _starts_alone(self, task: str) -> bool:
+        start = self._transitions[f"start:{task}"]
+        own = (start.id, f"complete:{task}")
+        touched = {place for place, _ in (*start.pre, *start.post)} | set(start.resets)
+        return not any(
+            place in touched
+            for transition in self.net.transitions
+            if transition.id not in own
+            for place, _ in transition.pre
+        )
 
     def _processes_started_by_a_message(self) -> list[tuple[Marking, Marking]]:
         """(initial tokens, end tokens) of each process whose every first step waits for a

@@ -114,9 +114,9 @@ def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a
     assert (message["job"], message["lease"], message["cobot"]["name"]) == (job.pk, 1, cobot.name)
     assert message["command"] == job.command
     # The case's lock, the item, its completion, the open items, the step's offer and job,
-    # the cobot's row, the step's start, the open items again, then the log, the lease and
-    # the case in one statement.
-    assert len(statements.sent) == 10, statements.sent
+    # the cobot's row, the step's start (which starts alone: no second read of the open
+    # items), then the log, the lease and the case in one statement.
+    assert len(statements.sent) == 9, statements.sent
 
 
 @pytest.mark.parametrize("busy", ["queued", "stopped", "locked by a worker"])
@@ -241,8 +241,9 @@ def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
     assert lease is not None
     assert lease.job_id == _job(item).pk
     # The cobot's lock, its queue, the case, the job and its item locked in one statement, the
-    # step's start, the open items, then the log, the lease and the case in one statement.
-    assert len(statements.sent) == 6, statements.sent
+    # step's start (alone: nothing else to offer or withdraw), then the log, the lease and the
+    # case in one statement.
+    assert len(statements.sent) == 5, statements.sent
 
 
 def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_hand_it_over(

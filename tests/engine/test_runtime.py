@@ -96,8 +96,10 @@ class _Run:
         assert moves, f"stuck in {self.marking} after {self.trace}"
         kind, task = self.rng.choice(moves)
         if kind == "start":
-            self.marking = self.net.start(self.marking, task)
+            before, self.marking = self.marking, self.net.start(self.marking, task)
             self.running[task] += 1
+            if task in self.net.starts_alone:
+                self.check_started_alone(task, before)
         else:
             self.marking = self.net.complete(self.marking, task)
             self.running[task] -= 1
@@ -106,6 +108,14 @@ class _Run:
         self.check_trace(kind, task)
         self.marking, _ = self.net.settle(self.marking, {})
         self.check_runtime_refuses()
+
+    def check_started_alone(self, task: str, before: Marking) -> None:
+        """A start the runtime follows with nothing (starts_alone) moved no other enabling."""
+        own = (f"start:{task}", f"complete:{task}")
+        for transition in self.net.net.transitions:
+            if transition.id not in own:
+                enabled = transition.is_enabled(before), transition.is_enabled(self.marking)
+                assert enabled[0] == enabled[1], (task, transition.id, self.trace)
 
     def check_trace(self, kind: str, task: str) -> None:
         for a, b in self.time:
@@ -226,6 +236,22 @@ def test_tasks_sharing_an_input_place_are_both_startable_until_one_starts() -> N
     with pytest.raises(NotEnabled, match="ta cannot start: it waits for a token in p1"):
         net.start(after, "ta")
     assert net.is_final(net.complete(after, "tb"))
+
+
+def test_a_task_starts_alone_unless_another_transition_takes_from_the_places_it_touches() -> None:
+    choice = CaseNet(
+        read_pattern(
+            document(process("N", "p1 ta p2", "p1 tb p2", performers={"ta": "o", "tb": "c"}))
+        )
+    )
+    sequence = CaseNet(read_pattern(two_lanes([])))
+    timed = CaseNet(read_pattern(two_lanes([("tc1", "to1", "time")])))  # to1 after tc1
+    supported = CaseNet(read_pattern(two_lanes([("to1", "tc2", "func")])))  # tc2 supports to1
+
+    assert choice.starts_alone == frozenset()  # each start withdraws the other
+    assert sequence.starts_alone == frozenset(sequence.tasks)
+    assert timed.starts_alone == frozenset(timed.tasks)  # tc1's completion lets to1 go
+    assert set(supported.tasks) - supported.starts_alone == {"tc2"}  # its start lets to1 go
 
 
 def test_starting_a_task_leaves_the_marking_it_was_given_alone() -> None:
