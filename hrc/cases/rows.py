@@ -53,33 +53,6 @@ def fetch_with(
         return [(_instance(model, row[:width]), tuple(row[width:])) for row in cursor.fetchall()]
 
 
-def fetch_one_with(
-    model: type[M], relation: str, where: str, params: Sequence[Any], *, lock: str = ""
-) -> M | None:
-    """fetch_one, the row its foreign key `relation` points to read along in the same statement
-    (a join, as select_related); `lock` locks the model's row only."""
-    field = model._meta.get_field(relation)
-    related: type[Model] = field.related_model  # type: ignore[assignment]
-    mine, _ = _columns(model, connection.vendor)
-    theirs, _ = _columns(related, connection.vendor)
-    quote = connection.ops.quote_name
-    join = (
-        f"{table(related)} ON {table(related)}.{quote(_column(related._meta.pk))} = "
-        f"{table(model)}.{quote(str(field.column))}"  # type: ignore[union-attr]
-    )
-    suffix = f" {lock} OF {table(model)}" if lock and connection.features.has_select_for_update else ""  # fmt: skip
-    sql = f"SELECT {mine}, {theirs} FROM {table(model)} JOIN {join} WHERE {where}{suffix}"
-    with connection.cursor() as cursor:
-        cursor.execute(sql, list(params))
-        row = cursor.fetchone()
-    if row is None:
-        return None
-    width = len(model._meta.concrete_fields)
-    instance = _instance(model, row[:width])
-    setattr(instance, relation, _instance(related, row[width:]))
-    return instance
-
-
 def fetch_each(
     models: Sequence[type[Model]], where: str, params: Sequence[Any], *, lock: str = ""
 ) -> tuple[Model, ...] | None:
