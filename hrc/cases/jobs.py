@@ -299,7 +299,9 @@ def lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
         f"{case}.id = %s AND {job}.id = %s AND {job}.case_id = {case}.id "
         f"AND {item}.id = {job}.work_item_id"
     )
-    found = rows.fetch_each((Case, Job, WorkItem), where, [case_id, job_id], lock="FOR NO KEY UPDATE")  # fmt: skip
+    found = rows.fetch_each(
+        (Case, Job, WorkItem), where, [case_id, job_id], lock="FOR NO KEY UPDATE"
+    )
     if found is None:
         raise Job.DoesNotExist(f"There is no job {job_id} in case {case_id}.")
     locked_case, locked_job, locked_item = cast(tuple[Case, Job, WorkItem], found)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import datetime as dt
 import threading
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -95,6 +96,38 @@ def _waiting_for_a_lock() -> bool:
         return bool(cursor.fetchone()[0])
 
 
+def _reach_while_held(hold: Callable[[], Any], reach: Callable[[], Any], waited: str) -> tuple[Any, Any]:  # fmt: skip
+    """Runs `hold` in a transaction held open on a thread of its own, then `reach` in one on
+    another thread, which must come to wait for a lock (`waited`: the failure if it never
+    does); then lets `hold` commit. Returns what each returned."""
+    held = threading.Event()
+    release = threading.Event()
+    results: dict[str, Any] = {}
+
+    def run(name: str, call: Callable[[], Any], then: Callable[[], None]) -> None:
+        try:
+            with transaction.atomic():
+                results[name] = call()
+                then()
+        finally:
+            connections.close_all()
+
+    def hold_open() -> None:
+        held.set()
+        release.wait(30)
+
+    holder = threading.Thread(target=run, args=("hold", hold, hold_open))
+    holder.start()
+    assert held.wait(30)
+    reacher = threading.Thread(target=run, args=("reach", reach, lambda: None))
+    reacher.start()
+    until(_waiting_for_a_lock, 30, 0.01, waited)
+    release.set()
+    holder.join(30)
+    reacher.join(30)
+    return results["hold"], results["reach"]
+
+
 @pytest.mark.django_db(transaction=True)
 def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
@@ -103,38 +136,14 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     cobot = _two_jobs_queued_on_one_cobot(organisation, engineer, operator)
     assert Job.objects.filter(cobot=cobot, state=JobState.QUEUED).count() == 2
 
-    leased = threading.Event()
-    release = threading.Event()
-    results: dict[str, Any] = {}
+    first, second = _reach_while_held(
+        lambda: jobs.lease_next_job(cobot.pk),  # the lease's own transaction, held open a moment
+        lambda: jobs.lease_next_job(cobot.pk),
+        "the second lease never waited for the cobot",
+    )
 
-    def first() -> None:
-        try:
-            with transaction.atomic():  # the lease's own transaction, held open a moment
-                results["first"] = jobs.lease_next_job(cobot.pk)
-                leased.set()
-                release.wait(30)
-        finally:
-            connections.close_all()
-
-    def second() -> None:
-        try:
-            results["second"] = jobs.lease_next_job(cobot.pk)
-        finally:
-            connections.close_all()
-
-    holder = threading.Thread(target=first)
-    holder.start()
-    assert leased.wait(30)
-    reacher = threading.Thread(target=second)
-    reacher.start()
-    # The second lease has begun and waits for the cobot.
-    until(_waiting_for_a_lock, 30, 0.01, "the second lease never waited for the cobot")
-    release.set()
-    holder.join(30)
-    reacher.join(30)
-
-    assert results["first"] is not None
-    assert results["second"] is None  # the cobot is busy with the first job
+    assert first is not None
+    assert second is None  # the cobot is busy with the first job
     assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
 
 
@@ -221,38 +230,16 @@ def test_a_lock_that_waited_for_the_case_reads_its_job_and_work_item_as_left_by_
     # before the wait, it must still read what the holder of the case's lock committed.
     cobot = _jobs_queued_on_a_cobot(organisation, engineer, operator, "alone", 1)
     job = Job.objects.get(cobot=cobot)
-    locked = threading.Event()
-    release = threading.Event()
-    results: dict[str, Any] = {}
 
-    def holder() -> None:
-        try:
-            with transaction.atomic():
-                progress.lock_case(job.case_id)
-                WorkItem.objects.filter(pk=job.work_item_id).update(state=WorkItemState.CANCELLED)
-                Job.objects.filter(pk=job.pk).update(waiting_for="cancelled meanwhile")
-                locked.set()
-                release.wait(30)
-        finally:
-            connections.close_all()
+    def cancel_meanwhile() -> None:
+        progress.lock_case(job.case_id)
+        WorkItem.objects.filter(pk=job.work_item_id).update(state=WorkItemState.CANCELLED)
+        Job.objects.filter(pk=job.pk).update(waiting_for="cancelled meanwhile")
 
-    def reader() -> None:
-        try:
-            with transaction.atomic():
-                results["read"] = jobs.lock_case_and_job(job.case_id, job.pk)
-        finally:
-            connections.close_all()
-
-    holding = threading.Thread(target=holder)
-    holding.start()
-    assert locked.wait(30)
-    reading = threading.Thread(target=reader)
-    reading.start()
-    until(_waiting_for_a_lock, 30, 0.01, "the lock never waited for the case")
-    release.set()
-    holding.join(30)
-    reading.join(30)
-
-    _, read = results["read"]
+    _, (_, read) = _reach_while_held(
+        cancel_meanwhile,
+        lambda: jobs.lock_case_and_job(job.case_id, job.pk),
+        "the lock never waited for the case",
+    )
     assert read.waiting_for == "cancelled meanwhile"
     assert read.work_item.state == WorkItemState.CANCELLED
