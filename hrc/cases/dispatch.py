@@ -74,10 +74,29 @@ def _send(task: Task, args: tuple[Any, ...], countdown: float) -> None:
         _submit_inline(executor, registered(task).run, args, countdown)
         return
     try:
-        # The cases' tasks keep no results (ignore_result on each): say so as apply_async would.
-        app.send_task(task.value, args, countdown=countdown or None, ignore_result=True)
+        # The cases' tasks keep no results (ignore_result on each), so nothing of what Celery
+        # prepares for a result is wanted: its object (a result backend made per thread, and a
+        # request runs on a thread of its own), the reply address (derived per thread) and a
+        # parent's list of children. Nor its safe repr of the arguments, small dicts and ints
+        # here. Together about half of a send's CPU in a request (bench/README.md).
+        app.send_task(
+            task.value, args, countdown=countdown or None, ignore_result=True,
+            argsrepr=repr(args), reply_to=NO_REPLY, result_cls=_Sent, add_to_parent=False,
+        )  # fmt: skip
     except Exception as error:  # the broker is down: the sweeper will find the row
         logger.warning("Could not send %s%s (%s); the sweeper will", task.value, args, error)
+
+
+# The reply address of a message whose task keeps no result: nothing is ever sent to it.
+NO_REPLY = "hrc.no-reply"
+
+
+class _Sent:
+    """What send_task returns for a message sent (its id): there is no result to wait for."""
+
+    def __init__(self, task_id: str) -> None:
+        self.id = task_id
+        self.ignored = True
 
 
 def registered(task: Task) -> CeleryTask:

@@ -111,9 +111,11 @@ def run_leased_job(message: Mapping[str, Any]) -> None:
 def _claim(lease: Lease) -> bool:
     """Makes the leased job this worker's, if it is still leased as the message says and no
     worker has claimed it: one statement, outside any transaction (the lease is the lock)."""
-    claimed = Job.objects.filter(
-        pk=lease.job_id, lease=lease.lease, state=JobState.RUNNING, held_by=""
-    ).update(held_by=progress.worker_name())
+    claimed = rows.update_where(
+        Job, {"held_by": progress.worker_name()},
+        "id = %s AND lease = %s AND state = %s AND held_by = ''",
+        [lease.job_id, lease.lease, JobState.RUNNING],
+    )  # fmt: skip
     return bool(claimed)
 
 

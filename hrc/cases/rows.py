@@ -85,6 +85,18 @@ def update(instance: Model, fields: Sequence[str]) -> int:
         return int(cursor.rowcount)
 
 
+def update_where(
+    model: type[Model], values: dict[str, Any], where: str, params: Sequence[Any]
+) -> int:
+    """UPDATE of `model`'s rows matching `where` (SQL over its columns, %s parameters): these
+    fields to these values; the rows changed."""
+    sql, chosen = _update_sql(model, tuple(values), where)
+    prepared = [field.get_db_prep_save(values[field.name], connection) for field in chosen]
+    with connection.cursor() as cursor:
+        cursor.execute(sql, [*prepared, *params])
+        return int(cursor.rowcount)
+
+
 def save_with(
     instance: Model,
     fields: Sequence[str],
@@ -189,14 +201,18 @@ def _chain(converters: list[Converter], column: Any) -> Callable[[Any], Any]:
 
 
 @functools.cache
-def _update_sql(model: type[Model], names: tuple[str, ...]) -> tuple[str, list[Field[Any, Any]]]:
+def _update_sql(
+    model: type[Model], names: tuple[str, ...], where: str = ""
+) -> tuple[str, list[Field[Any, Any]]]:
+    """The UPDATE of the fields `names` of the rows matching `where` (by default: the primary
+    key), and those fields, in the order of their parameters."""
     quote = connection.ops.quote_name
     chosen = [field for field in model._meta.concrete_fields if field.name in names]
     if len(chosen) != len(set(names)):
         raise ValueError(f"{model.__name__} has no field among some of {names}.")
     assignments = ", ".join(f"{quote(_column(field))} = %s" for field in chosen)
-    primary = quote(_column(model._meta.pk))
-    return f"UPDATE {table(model)} SET {assignments} WHERE {primary} = %s", chosen
+    where = where or f"{quote(_column(model._meta.pk))} = %s"
+    return f"UPDATE {table(model)} SET {assignments} WHERE {where}", chosen
 
 
 @functools.cache
