@@ -18,7 +18,7 @@ import os
 import socket
 from collections import Counter
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, cast
 
 from django.conf import settings
 from django.contrib.auth.models import User
@@ -90,23 +90,23 @@ def lock_case(case_id: int) -> Case:
 
 
 def lock_operator_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem]:
-    """The case (locked) and a fresh copy of an operator work item the user may perform,
-    the case and the user it is claimed by attached.
+    """The case and an operator work item the user may perform, both locked, in one statement;
+    the case and the user it is claimed by attached to the item.
 
     The case is found through the item and the user's active membership of its organisation
     in the statement that locks it: the organisations' wall costs the request no read of its
-    own. The item is read after the lock, in a statement of its own: one that waited for the
-    lock sees what the transaction it waited for committed (READ COMMITTED).
+    own. The item is locked too, after its case (the project's lock order), so that both are
+    read as they are once the locks are held, even by a statement that waited for them.
     """
     item_id: int = item.pk if isinstance(item, WorkItem) else item
-    lock_sql, performable_sql = _operator_item_sql()
-    case = rows.fetch_one(Case, lock_sql, [item_id, user.pk], lock="FOR NO KEY UPDATE")
-    if case is None:
+    where, performable_sql = _operator_item_sql()
+    found = rows.fetch_each_with(
+        (Case, WorkItem), where, [user.pk, user.pk, item_id, user.pk], [performable_sql],
+        lock="FOR NO KEY UPDATE",
+    )  # fmt: skip
+    if found is None:
         raise NotFound(f"There is no work item {item_id} in your organisations.")
-    found = rows.fetch_with(WorkItem, "id = %s", [user.pk, user.pk, item_id], [performable_sql])
-    if not found:  # deleted with its case meanwhile
-        raise NotFound(f"There is no work item {item_id} in your organisations.")
-    [(item, (performable,))] = found
+    (case, item), (performable,) = cast(tuple[tuple[Case, WorkItem], tuple[bool]], found)
     check_operator_task(item)
     if not performable:
         raise NotAllowed(f"{item.label} is not offered to you.")
@@ -119,15 +119,15 @@ def lock_operator_item(item: WorkItem | int, user: User) -> tuple[Case, WorkItem
 
 @functools.cache
 def _operator_item_sql() -> tuple[str, str]:
-    """lock_operator_item's conditions in SQL: the case of item %s whose organisation user %s
-    is an active member of; whether the item is offered to user %s (a candidate, or in its
-    team: selectors.performable_by's rule), with the item's table as `items`."""
+    """lock_operator_item's conditions in SQL: item %s and its case, whose organisation user
+    %s is an active member of; whether the item is offered to user %s (a candidate, or in its
+    team: selectors.performable_by's rule)."""
     items, cases = rows.table(WorkItem), rows.table(Case)
     members = rows.table(Membership)
     candidates = rows.table(WorkItem.candidates.through)
     teams = rows.table(Team.members.through)
-    lock = (
-        f"id = (SELECT case_id FROM {items} WHERE id = %s) AND EXISTS (SELECT 1 FROM {members} m "
+    where = (
+        f"{items}.id = %s AND {cases}.id = {items}.case_id AND EXISTS (SELECT 1 FROM {members} m "
         f"WHERE m.organisation_id = {cases}.organisation_id AND m.user_id = %s AND m.is_active)"
     )
     performable = (
@@ -136,7 +136,7 @@ def _operator_item_sql() -> tuple[str, str]:
         f"JOIN {members} m ON m.id = t.membership_id "
         f"WHERE t.team_id = {items}.team_id AND m.user_id = %s)))"
     )
-    return lock, performable
+    return where, performable
 
 
 def check_operator_task(item: WorkItem) -> None:
@@ -257,15 +257,15 @@ def _offer(case: Case, net: CaseNet, task: str) -> WorkItem:
         # A device call is its device's work: the cobot's queue stays free meanwhile.
         cobot_id=None if device_id else binding.get("cobot"), device_id=device_id,
     )  # fmt: skip
-    rows.insert(item)
     if config.kind == "operator":
+        rows.insert(item)
         # A new item has no candidates yet: insert them in one statement.
         Candidate = WorkItem.candidates.through
         Candidate.objects.bulk_create(
             Candidate(workitem_id=item.pk, user_id=user_id) for user_id in binding.get("users", ())
         )
     else:
-        _queue_job(case, net, item, config)
+        _queue_job(case, net, item, config)  # the item with it
     record_event(case, EventType.TASK_OFFERED, item=item)
     return item
 
@@ -282,22 +282,22 @@ def _device_of(binding: Mapping[str, Any], config: TaskConfig) -> int | None:
 
 
 def _queue_job(case: Case, net: CaseNet, item: WorkItem, config: TaskConfig) -> None:
+    """Inserts the new item and its job, queued (or failed, when its command cannot be made)."""
     # A cobot task's actor maps to a cobot, a device call to a device (mapping.py).
     assert item.cobot_id is not None or item.device_id is not None
     now = timezone.now()
     job = Job(
-        work_item=item, case=case, cobot_id=item.cobot_id, device_id=item.device_id,
-        kind=config.kind,
+        case=case, cobot_id=item.cobot_id, device_id=item.device_id, kind=config.kind,
         timeout=config.timeout, retries_left=config.retries, next_try_at=now, command={},
     )  # fmt: skip
     try:
         job.command = cobot_command(item.task, config, case.data)
     except RuntimeFault as fault:
         job.state, job.last_error = JobState.FAILED, str(fault)
-        job.save()
-        open_incident(case, IncidentKind.CASE_FAULT, str(fault), item=item)
+    rows.insert_with(item, job, "work_item")
+    if job.state == JobState.FAILED:
+        open_incident(case, IncidentKind.CASE_FAULT, job.last_error, item=item)
         return
-    rows.insert(job)
     jobs_queued_now(case).append(job)
     # The queue's doorbell, unless hand_over leased the job in this transaction (its message
     # goes to a worker instead) or saw a step running on the cobot (its worker leases the

@@ -60,9 +60,25 @@ def fetch_each(
     narrows each to one row; None when there is no such row. `lock` locks every row, in the
     order of `models` (PostgreSQL takes a statement's row locks table by table, in FROM
     order), and then reads each as its newest committed version, even after waiting."""
+    found = fetch_each_with(models, where, params, (), lock=lock)
+    return None if found is None else found[0]
+
+
+def fetch_each_with(
+    models: Sequence[type[Model]],
+    where: str,
+    params: Sequence[Any],
+    extra: Sequence[str],
+    *,
+    lock: str = "",
+) -> tuple[tuple[Model, ...], tuple[Any, ...]] | None:
+    """fetch_each, with the values of the `extra` SQL expressions read along (their parameters
+    come first in `params`)."""
     selected = ", ".join(_columns(model, connection.vendor)[0] for model in models)
+    more = "".join(f", {expression}" for expression in extra)
     suffix = f" {lock}" if lock and connection.features.has_select_for_update else ""
-    sql = f"SELECT {selected} FROM {', '.join(table(model) for model in models)} WHERE {where}{suffix}"
+    tables = ", ".join(table(model) for model in models)
+    sql = f"SELECT {selected}{more} FROM {tables} WHERE {where}{suffix}"
     with connection.cursor() as cursor:
         cursor.execute(sql, list(params))
         row = cursor.fetchone()
@@ -73,7 +89,7 @@ def fetch_each(
         width = len(model._meta.concrete_fields)
         found.append(_instance(model, row[start : start + width]))
         start += width
-    return tuple(found)
+    return tuple(found), tuple(row[start:])
 
 
 def update(instance: Model, fields: Sequence[str]) -> int:
@@ -145,6 +161,36 @@ def insert(instance: Model) -> None:
         cursor.execute(sql, _values(instance, fields, adding=True))
         instance.pk = cursor.fetchone()[0]
     instance._state.adding, instance._state.db = False, connection.alias
+
+
+def insert_with(instance: Model, child: Model, link: str) -> None:
+    """insert of a new instance and of a new `child` whose foreign key `link` points at it, in
+    one statement (PostgreSQL: a WITH of data-modifying statements), else one each; sets both
+    primary keys and the child's key."""
+    if connection.vendor != "postgresql":
+        insert(instance)
+        setattr(child, link, instance)
+        insert(child)
+        return
+    head, fields = _insert_head(type(instance))
+    child_head, child_fields = _insert_head(type(child))
+    key = next(field for field in child_fields if field.name == link)
+    quote = connection.ops.quote_name
+    primary = quote(_column(type(instance)._meta.pk))
+    child_primary = quote(_column(type(child)._meta.pk))
+    selected = ", ".join(f"parent.{primary}" if field is key else "%s" for field in child_fields)
+    sql = (
+        f"WITH parent AS ({head} VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}) "
+        f"{child_head} SELECT {selected} FROM parent RETURNING {child_primary}, {quote(_column(key))}"
+    )
+    child_values = [field for field in child_fields if field is not key]
+    params = [*_values(instance, fields, adding=True), *_values(child, child_values, adding=True)]
+    with connection.cursor() as cursor:
+        cursor.execute(sql, params)
+        child.pk, instance.pk = cursor.fetchone()
+    setattr(child, link, instance)
+    for new in (instance, child):
+        new._state.adding, new._state.db = False, connection.alias
 
 
 def _values(instance: Model, fields: Sequence[Field[Any, Any]], *, adding: bool) -> list[Any]:

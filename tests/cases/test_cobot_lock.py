@@ -29,6 +29,8 @@ from hrc.cases.models import Case, Job, WorkItem
 from hrc.celery import app
 from hrc.cobots.choices import CommandOutcome, ControlCommand
 from hrc.cobots.models import Cobot, CobotCommand
+from hrc.errors import Conflict
+from hrc.organisations.choices import Role
 from hrc.organisations.models import Organisation
 from tests import factories
 from tests.cases.patterns import PROGRAM
@@ -243,3 +245,35 @@ def test_a_lock_that_waited_for_the_case_reads_its_job_and_work_item_as_left_by_
     )
     assert read.waiting_for == "cancelled meanwhile"
     assert read.work_item.state == WorkItemState.CANCELLED
+
+
+@pytest.mark.django_db(transaction=True)
+def test_an_operator_action_that_waited_for_the_case_reads_its_work_item_as_left_by_the_holder(
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User
+) -> None:
+    # One statement locks the case and the operator's work item (progress.lock_operator_item):
+    # begun before the wait, it must still read what the holder of the case's lock committed.
+    cobot = factories.make_cobot(organisation, name="handed")
+    version = factories.make_version(organisation, published_by=engineer)
+    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}}
+    case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
+    item = factories.open_work_item(case, "to1")
+    case_services.start_work_item(item, user=operator)
+    other = factories.make_member(organisation, Role.OPERATOR)
+
+    def reassign_meanwhile() -> None:
+        progress.lock_case(case.pk)
+        WorkItem.objects.filter(pk=item.pk).update(claimed_by=other)
+
+    def complete() -> str:
+        try:
+            case_services.complete_work_item(item.pk, user=operator)
+        except Conflict as refused:
+            return str(refused)
+        return "completed"
+
+    _, answer = _reach_while_held(
+        reassign_meanwhile, complete, "the completion never waited for the case"
+    )
+    assert answer == f"{item.label} is being done by someone else."
+    assert WorkItem.objects.get(pk=item.pk).state == WorkItemState.RUNNING

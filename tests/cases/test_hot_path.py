@@ -113,10 +113,10 @@ def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a
     assert task == Task.RUN_LEASED_JOB
     assert (message["job"], message["lease"], message["cobot"]["name"]) == (job.pk, 1, cobot.name)
     assert message["command"] == job.command
-    # The case's lock, the item, its completion, the open items, the step's offer and job,
-    # the cobot's row, the step's start (which starts alone: no second read of the open
+    # The case and the item locked, its completion, the open items, the step's offer with its
+    # job, the cobot's row, the step's start (which starts alone: no second read of the open
     # items), then the log, the lease and the case in one statement.
-    assert len(statements.sent) == 9, statements.sent
+    assert len(statements.sent) == 7, statements.sent
 
 
 @pytest.mark.parametrize("busy", ["queued", "stopped", "locked by a worker"])
