@@ -16,9 +16,9 @@ from django.db import connection, connections, transaction
 from django.utils import timezone
 
 from hrc.cases import dispatch, jobs, progress, services
-from hrc.cases.choices import CaseStatus, JobState, WorkItemState
+from hrc.cases.choices import CaseStatus, IncidentKind, JobState, WorkItemState
 from hrc.cases.dispatch import Task
-from hrc.cases.models import Case, Job, WorkItem
+from hrc.cases.models import Case, Incident, Job, WorkItem
 from hrc.cobots.models import Cobot
 from hrc.organisations.models import Organisation
 from hrc.patterns.models import PatternVersion
@@ -117,6 +117,26 @@ def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a
     # job, the cobot's row, the step's start (which starts alone: no second read of the open
     # items), then the log, the lease and the case in one statement.
     assert len(statements.sent) == 7, statements.sent
+
+
+def test_a_step_whose_command_cannot_be_made_is_offered_with_its_job_failed_and_an_incident(
+    organisation: Organisation, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    document = factories.valid_document()
+    document["data"] = {"batch": "many"}
+    document["processes"][0]["transitions"][1]["task"] = {"step": {"number": "=data.batch"}}
+    version = factories.make_version(organisation, published_by=engineer, draft=document)
+    item = _started(version, engineer, operator, cobot)
+    with sent_tasks() as sent:
+        services.complete_work_item(item, user=operator)
+    assert sent == []  # nothing to lease, no doorbell
+    job = _job(item)
+    assert job.state == JobState.FAILED
+    assert "not a whole number" in job.last_error
+    step = WorkItem.objects.get(pk=job.work_item_id)
+    assert (step.task, step.state) == ("tc1", WorkItemState.OFFERED)
+    [incident] = Incident.objects.filter(case_id=item.case_id)
+    assert (incident.kind, incident.work_item_id) == (IncidentKind.CASE_FAULT, step.pk)
 
 
 @pytest.mark.parametrize("busy", ["queued", "stopped", "locked by a worker"])
