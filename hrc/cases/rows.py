@@ -147,20 +147,16 @@ def save_with(
     params += _values(instance, chosen, adding=False)
     with connection.cursor() as cursor:
         cursor.execute(f"WITH {', '.join(parts)} {sql}" if parts else sql, [*params, instance.pk])
-    for new in inserts:
-        new._state.adding, new._state.db = False, connection.alias
+    _saved(*inserts)
 
 
 def insert(instance: Model) -> None:
     """INSERT of a new instance, as Model.save() would (defaults, auto_now_add); sets its pk."""
-    model = type(instance)
-    head, fields = _insert_head(model)
-    primary = connection.ops.quote_name(_column(model._meta.pk))
-    sql = f"{head} VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}"
+    sql, fields = _insert_returning_key(type(instance))
     with connection.cursor() as cursor:
         cursor.execute(sql, _values(instance, fields, adding=True))
         instance.pk = cursor.fetchone()[0]
-    instance._state.adding, instance._state.db = False, connection.alias
+    _saved(instance)
 
 
 def insert_with(instance: Model, child: Model, link: str) -> None:
@@ -172,7 +168,7 @@ def insert_with(instance: Model, child: Model, link: str) -> None:
         setattr(child, link, instance)
         insert(child)
         return
-    head, fields = _insert_head(type(instance))
+    parent_sql, fields = _insert_returning_key(type(instance))
     child_head, child_fields = _insert_head(type(child))
     key = next(field for field in child_fields if field.name == link)
     quote = connection.ops.quote_name
@@ -180,7 +176,7 @@ def insert_with(instance: Model, child: Model, link: str) -> None:
     child_primary = quote(_column(type(child)._meta.pk))
     selected = ", ".join(f"parent.{primary}" if field is key else "%s" for field in child_fields)
     sql = (
-        f"WITH parent AS ({head} VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}) "
+        f"WITH parent AS ({parent_sql}) "
         f"{child_head} SELECT {selected} FROM parent RETURNING {child_primary}, {quote(_column(key))}"
     )
     child_values = [field for field in child_fields if field is not key]
@@ -189,8 +185,13 @@ def insert_with(instance: Model, child: Model, link: str) -> None:
         cursor.execute(sql, params)
         child.pk, instance.pk = cursor.fetchone()
     setattr(child, link, instance)
-    for new in (instance, child):
-        new._state.adding, new._state.db = False, connection.alias
+    _saved(instance, child)
+
+
+def _saved(*instances: Model) -> None:
+    """Marks new instances as rows of this database, as Model.save() does once it inserted them."""
+    for instance in instances:
+        instance._state.adding, instance._state.db = False, connection.alias
 
 
 def _values(instance: Model, fields: Sequence[Field[Any, Any]], *, adding: bool) -> list[Any]:
@@ -259,6 +260,14 @@ def _update_sql(
     assignments = ", ".join(f"{quote(_column(field))} = %s" for field in chosen)
     where = where or f"{quote(_column(model._meta.pk))} = %s"
     return f"UPDATE {table(model)} SET {assignments} WHERE {where}", chosen
+
+
+@functools.cache
+def _insert_returning_key(model: type[Model]) -> tuple[str, list[Field[Any, Any]]]:
+    """The INSERT of one row of `model`, its primary key returned, and the fields it takes."""
+    head, fields = _insert_head(model)
+    primary = connection.ops.quote_name(_column(model._meta.pk))
+    return f"{head} VALUES ({', '.join(['%s'] * len(fields))}) RETURNING {primary}", fields
 
 
 @functools.cache
