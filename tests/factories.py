@@ -223,14 +223,23 @@ def hand_over_case(
     """A case of the hand-over pattern (valid_document()) whose operator has prepared the
     workpiece (to1 done): its cobot step is leased for the workers when the cobot was free
     (the completion hands it over; no worker has claimed it), else it waits in the queue."""
+    item = hand_over_started(version, started_by=started_by, operator=operator, cobot=cobot)
+    case_services.complete_work_item(item, user=operator)
+    return item.case
+
+
+def hand_over_started(
+    version: PatternVersion, *, started_by: User, operator: User, cobot: Cobot
+) -> WorkItem:
+    """The operator task (to1) of a new case of the hand-over pattern, started by `operator`:
+    its completion enables the cobot's step."""
     case = make_case(
         version, started_by=started_by,
         actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
     )  # fmt: skip
     item = open_work_item(case, "to1")
     case_services.start_work_item(item, user=operator)
-    case_services.complete_work_item(item, user=operator)
-    return case
+    return item
 
 
 def open_work_item(case: Case, task: str) -> WorkItem:

@@ -255,14 +255,11 @@ def test_an_operator_action_that_waited_for_the_case_reads_its_work_item_as_left
     # begun before the wait, it must still read what the holder of the case's lock committed.
     cobot = factories.make_cobot(organisation, name="handed")
     version = factories.make_version(organisation, published_by=engineer)
-    mapping = {"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}}
-    case = factories.make_case(version, started_by=engineer, actor_mapping=mapping)
-    item = factories.open_work_item(case, "to1")
-    case_services.start_work_item(item, user=operator)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     other = factories.make_member(organisation, Role.OPERATOR)
 
     def reassign_meanwhile() -> None:
-        progress.lock_case(case.pk)
+        progress.lock_case(item.case_id)
         WorkItem.objects.filter(pk=item.pk).update(claimed_by=other)
 
     def complete() -> str:

@@ -66,17 +66,6 @@ def version(organisation: Organisation, engineer: User) -> PatternVersion:
     return factories.make_version(organisation, published_by=engineer)
 
 
-def _started(version: PatternVersion, engineer: User, operator: User, cobot: Cobot) -> WorkItem:
-    """The operator task of a new hand-over case, started: its completion enables the step."""
-    case = factories.make_case(
-        version, started_by=engineer,
-        actor_mapping={"o": {"users": [operator.pk]}, "c": {"cobot": cobot.pk}},
-    )  # fmt: skip
-    item = factories.open_work_item(case, "to1")
-    services.start_work_item(item, user=operator)
-    return item
-
-
 def _job(item: WorkItem) -> Job:
     return Job.objects.select_related("cobot").get(case_id=item.case_id)
 
@@ -103,7 +92,7 @@ def _queued(items: list[WorkItem], operator: User, cobot: Cobot) -> None:
 def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a_doorbell(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     with sent_tasks() as sent, counted() as statements:
         services.complete_work_item(item, user=operator)
     job = _job(item)
@@ -126,7 +115,7 @@ def test_a_step_whose_command_cannot_be_made_is_offered_with_its_job_failed_and_
     document["data"] = {"batch": "many"}
     document["processes"][0]["transitions"][1]["task"] = {"step": {"number": "=data.batch"}}
     version = factories.make_version(organisation, published_by=engineer, draft=document)
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     with sent_tasks() as sent:
         services.complete_work_item(item, user=operator)
     assert sent == []  # nothing to lease, no doorbell
@@ -143,8 +132,10 @@ def test_a_step_whose_command_cannot_be_made_is_offered_with_its_job_failed_and_
 def test_a_completion_queues_the_step_when_its_cobot_is_not_free(
     busy: str, version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    ahead = _started(version, engineer, operator, cobot)
-    item = _started(version, engineer, operator, cobot)
+    ahead = factories.hand_over_started(
+        version, started_by=engineer, operator=operator, cobot=cobot
+    )
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     if busy == "queued":
         services.complete_work_item(ahead, user=operator)  # its step leased: the cobot has work
     elif busy == "stopped":
@@ -191,7 +182,7 @@ def _cobot_locked(cobot_id: int | None) -> Iterator[None]:
 def test_a_worker_claims_a_leased_step_once_in_one_statement(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     lease = _leased(item, operator)
     with counted() as statements:
         assert jobs._claim(lease)
@@ -204,7 +195,7 @@ def test_the_sweeper_sends_an_unclaimed_lease_again(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot, settings: Any
 ) -> None:
     settings.HRC_SWEEP_SECONDS = 0.0
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     with sent_tasks() as lost:
         services.complete_work_item(item, user=operator)
     with sent_tasks() as sent:
@@ -220,7 +211,7 @@ def test_an_unclaimed_lease_is_sent_again_at_1_2_4_8_sweeps_of_age_not_at_every_
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot, settings: Any
 ) -> None:
     settings.HRC_SWEEP_SECONDS = 2.0
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     with sent_tasks():
         services.complete_work_item(item, user=operator)  # its message lost, or waiting its turn
     leased_at = _job(item).started_at
@@ -238,7 +229,7 @@ def test_an_unclaimed_lease_is_sent_again_at_1_2_4_8_sweeps_of_age_not_at_every_
 def test_the_finish_runs_a_fixed_number_of_statements(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     lease = _leased(item, operator)
     assert jobs._claim(lease)
     with sent_tasks(), counted() as statements:
@@ -254,7 +245,7 @@ def test_the_finish_runs_a_fixed_number_of_statements(
 def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    item = _started(version, engineer, operator, cobot)
+    item = factories.hand_over_started(version, started_by=engineer, operator=operator, cobot=cobot)
     _queued([item], operator, cobot)
     with counted() as statements:
         lease = jobs._lease_next("id = %s", cobot.pk)  # what a doorbell runs (run_next_job)
@@ -269,8 +260,12 @@ def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
 def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_hand_it_over(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    first = _started(version, engineer, operator, cobot)
-    second = _started(version, engineer, operator, cobot)
+    first = factories.hand_over_started(
+        version, started_by=engineer, operator=operator, cobot=cobot
+    )
+    second = factories.hand_over_started(
+        version, started_by=engineer, operator=operator, cobot=cobot
+    )
     lease = _leased(first, operator)
     with sent_tasks():
         services.complete_work_item(second, user=operator)  # queued behind the first
@@ -290,7 +285,16 @@ def test_a_lease_handed_to_the_workers_is_the_cobots_only_one(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
     """The lease that hands the next job over ends the lease: the cobot has a job running."""
-    _queued([_started(version, engineer, operator, cobot) for _ in range(3)], operator, cobot)
+    _queued(
+        [
+            factories.hand_over_started(
+                version, started_by=engineer, operator=operator, cobot=cobot
+            )
+            for _ in range(3)
+        ],
+        operator,
+        cobot,
+    )
     with sent_tasks() as rung:
         jobs._lease_next("id = %s", cobot.pk, hand_over=True)
     assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
