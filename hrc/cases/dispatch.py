@@ -117,12 +117,21 @@ def _submit_inline(
             # A pool thread's connection would outlive the run (and block dropping the database).
             connections.close_all()
 
+    def submit() -> None:
+        try:
+            executor.submit(call)
+        except RuntimeError:
+            # The pool is shut down: the process is exiting (the embedded sweeper's or a
+            # timer's daemon thread woke after the interpreter began its shutdown). What the
+            # task would do is left in the rows, for the next process's sweeper.
+            logger.debug("Not run, the process is exiting: %s", run)
+
     if countdown:
-        timer = threading.Timer(countdown, lambda: executor.submit(call))
+        timer = threading.Timer(countdown, submit)
         timer.daemon = True
         timer.start()
     else:
-        executor.submit(call)
+        submit()
 
 
 @functools.cache

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import pytest
@@ -53,3 +54,12 @@ def test_the_embedded_sweeper_finds_a_job_whose_doorbell_was_lost(
 def _last_error(job: Job) -> str:
     job.refresh_from_db()
     return job.last_error
+
+
+def test_a_task_sent_to_the_embedded_pool_as_the_process_exits_is_left_to_the_sweeper() -> None:
+    # The sweeper's daemon thread can wake after the interpreter shut the pool down.
+    ran: list[int] = []
+    pool = ThreadPoolExecutor(max_workers=1)
+    pool.shutdown()
+    dispatch._submit_inline(pool, ran.append, (1,), 0)  # no RuntimeError, no traceback
+    assert ran == []
