@@ -2,7 +2,8 @@
 
 (A device's calls have a queue of their own, hrc.cases.device_jobs; they share this
 module's finish and fail paths, and its sweeper. Lock order: cobot row, or a device job's
-device row, then case row, then job row.)
+device row, then case row, then job row; a worker that leases the cobot's next job while it
+holds the case it finished takes both rows without waiting, SKIP LOCKED.)
 
 One cobot runs one job at a time. `run_next_job` takes the cobot's row lock,
 and only when no job of that cobot is running does it lease the first
@@ -133,17 +134,19 @@ def _drive(take: Callable[[], Lease | None]) -> None:
     younger than HRC_CHAIN_SECONDS, else handed to the workers, so that a worker serving a
     busy cobot lets the other cobots' doorbells have their turn."""
     began = time.monotonic()
+
+    def old() -> bool:
+        return time.monotonic() - began >= settings.HRC_CHAIN_SECONDS
+
     lease = take()
     while lease is not None:
-        _run(lease)
-        young = time.monotonic() - began < settings.HRC_CHAIN_SECONDS
-        lease = _lease_next("id = %s", lease.cobot.pk, hand_over=not young)
-        if not young:
-            return  # the next job, if any, went to the workers with its lease
+        lease = _run(lease, hand_over=old)
 
 
-def _run(lease: Lease) -> None:
-    """Drives one leased job and records how it ended."""
+def _run(lease: Lease, hand_over: Callable[[], bool]) -> Lease | None:
+    """Drives one leased job, records how it ended and leases the cobot's next job: the lease
+    returned, for this worker to drive; None when there is none, or when `hand_over()`, asked
+    once the step has ended, said it goes to the workers (its message sent on commit)."""
     # The cobot first, the tablets right after: what taking the job broadcasts (its task
     # started, the queue) waits until the cobot has accepted the step (events.hold_publishing).
     hold = events.hold_publishing()
@@ -154,6 +157,7 @@ def _run(lease: Lease) -> None:
         accepted.append(timezone.now())
         hold.release()
 
+    result: dict[str, Any] | None = None
     try:
         result = _execute(lease, on_sent=on_sent)
     except DriverError as error:
@@ -167,11 +171,15 @@ def _run(lease: Lease) -> None:
             "See the workers' log, check the cobot, then retry or skip."
         )
         fail_job(lease, DriverError(message), accepted_at=accepted[0] if accepted else None)
-    else:
-        # No doorbell for the cobot's next job: _drive leases it next.
-        finish_job(lease, result, accepted_at=accepted[0] if accepted else None, ring=False)
     finally:
         hold.release()
+    handing = hand_over()
+    if result is None:
+        taken = _lease_next("id = %s", lease.cobot.pk, hand_over=handing)
+    else:
+        accepted_at = accepted[0] if accepted else None
+        taken = _finish_and_lease_next(lease, result, accepted_at=accepted_at, hand_over=handing)
+    return None if handing else taken
 
 
 def lease_next_job(cobot_id: int) -> Lease | None:
@@ -193,35 +201,52 @@ def _lease_next(which: str, key: int, *, hand_over: bool = False) -> Lease | Non
     """`lease_next_job` for the cobot `which` selects (SQL over the cobot's columns, `key` its
     parameter: the cobot's own id, or one of its jobs'). `hand_over`: the lease is taken for
     the workers, its message sent once it commits (run_leased_job): not this caller's to drive."""
-    now = timezone.now()
     with transaction.atomic():
-        # The lock first, then the reasons to wait in a statement of their own: a statement
-        # sees what was committed when it began, so one that waited for the lock would not
-        # see the job the lease before it took (READ COMMITTED; tests/cases/test_cobot_lock.py).
-        # NO KEY: a case service inserting a job or an interruption takes a key-share lock
-        # on the cobot row (the foreign key) while it holds its case; FOR UPDATE would
-        # wait for it while we wait for the case, a deadlock.
-        # A locked row is read as it is now, whatever the statement's snapshot: its own
-        # columns (stopped_at) may come with the lock.
-        cobot = rows.fetch_one(Cobot, which, [key], lock="FOR NO KEY UPDATE")
-        if cobot is None:
+        return _take_next(which, key, hand_over=hand_over, wait=True)
+
+
+class _LockTaken(Exception):
+    """A row that a lease taken without waiting needs is locked by another session."""
+
+
+def _take_next(which: str, key: int, *, hand_over: bool, wait: bool) -> Lease | None:
+    """_lease_next in the caller's transaction. `wait=False`: raises _LockTaken rather than wait
+    for the cobot's row or a queued job's case (SKIP LOCKED); what it wrote before stands."""
+    now = timezone.now()
+    # The lock first, then the reasons to wait in a statement of their own: a statement
+    # sees what was committed when it began, so one that waited for the lock would not
+    # see the job the lease before it took (READ COMMITTED; tests/cases/test_cobot_lock.py).
+    # NO KEY: a case service inserting a job or an interruption takes a key-share lock
+    # on the cobot row (the foreign key) while it holds its case; FOR UPDATE would
+    # wait for it while we wait for the case, a deadlock.
+    # A locked row is read as it is now, whatever the statement's snapshot: its own
+    # columns (stopped_at) may come with the lock.
+    cobot = rows.fetch_one(Cobot, which, [key], lock=_row_lock(wait))
+    if cobot is None:
+        if not wait:
+            raise _LockTaken(f"cobot {which} ({key})")
+        return None
+    if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.cobots.stops)
+        return None
+    # The queue, with the reasons the whole cobot waits (a job running, a pause for an
+    # operator in a shared area) on each row: a second statement, so they are fresh.
+    # `held`: another case's func hold reserves the cobot; the holding case's own jobs
+    # may go (its pattern may give the cobot the supported task itself).
+    queued = _queue(cobot=cobot.pk, now=now)
+    for job_id, case_id, busy, paused, held, commanded, speed_due in queued:
+        if busy or paused or commanded:
             return None
-        if cobot.stopped_at is not None:  # a tablet's STOP holds the cobot (hrc.cobots.stops)
-            return None
-        # The queue, with the reasons the whole cobot waits (a job running, a pause for an
-        # operator in a shared area) on each row: a second statement, so they are fresh.
-        # `held`: another case's func hold reserves the cobot; the holding case's own jobs
-        # may go (its pattern may give the cobot the supported task itself).
-        queued = _queue(cobot=cobot.pk, now=now)
-        for job_id, case_id, busy, paused, held, commanded, speed_due in queued:
-            if busy or paused or commanded:
-                return None
-            lease = _lease_if_ready(
-                cobot, job_id, case_id, now, held=held, speed_due=speed_due, hand_over=hand_over
-            )
-            if lease is not None:
-                return lease
+        lease = _lease_if_ready(
+            cobot, job_id, case_id, now,
+            held=held, speed_due=speed_due, hand_over=hand_over, wait=wait,
+        )  # fmt: skip
+        if lease is not None:
+            return lease
     return None
+
+
+def _row_lock(wait: bool) -> str:
+    return "FOR NO KEY UPDATE" if wait else "FOR NO KEY UPDATE SKIP LOCKED"
 
 
 @rows.Compiled
@@ -258,11 +283,12 @@ def _lease_if_ready(
     held: bool,
     speed_due: bool,
     hand_over: bool,
+    wait: bool,
 ) -> Lease | None:
     """Leases the job when it may start now, else records why it waits; `held` and `speed_due`
     are the queue statement's (_queue; a hold is asked again here); `hand_over` as in
-    _lease_next."""
-    case, job = lock_case_and_job(case_id, job_id)
+    _lease_next, `wait` as in _take_next."""
+    case, job = lock_case_and_job(case_id, job_id, wait=wait)
     if job.state != JobState.QUEUED or case.status != CaseStatus.RUNNING:
         return None
     item = job.work_item
@@ -291,19 +317,20 @@ def _lease_if_ready(
     )  # fmt: skip
 
 
-def lock_case_and_job(case_id: int, job_id: int) -> tuple[Case, Job]:
+def lock_case_and_job(case_id: int, job_id: int, *, wait: bool = True) -> tuple[Case, Job]:
     """Both rows locked, in the project's lock order (case, then job), and the job's work item
     with them, in one statement. The work item is locked too, so that all three are read as
     they are once the locks are held: a locked row is read in its newest committed version,
-    another row as the statement found it before any wait (READ COMMITTED)."""
+    another row as the statement found it before any wait (READ COMMITTED). `wait=False`:
+    _LockTaken when another session holds one of them."""
     case, job, item = (rows.table(model) for model in (Case, Job, WorkItem))
     where = (
         f"{case}.id = %s AND {job}.id = %s AND {job}.case_id = {case}.id "
         f"AND {item}.id = {job}.work_item_id"
     )
-    found = rows.fetch_each(
-        (Case, Job, WorkItem), where, [case_id, job_id], lock="FOR NO KEY UPDATE"
-    )
+    found = rows.fetch_each((Case, Job, WorkItem), where, [case_id, job_id], lock=_row_lock(wait))
+    if found is None and not wait:
+        raise _LockTaken(f"case {case_id} or its job {job_id}")
     if found is None:
         raise Job.DoesNotExist(f"There is no job {job_id} in case {case_id}.")
     locked_case, locked_job, locked_item = cast(tuple[Case, Job, WorkItem], found)
@@ -436,34 +463,51 @@ def _mark_sent(lease: Lease) -> bool:
 
 
 def finish_job(
-    lease: Lease,
-    result: dict[str, Any],
-    *,
-    accepted_at: dt.datetime | None = None,
-    ring: bool = True,
+    lease: Lease, result: dict[str, Any], *, accepted_at: dt.datetime | None = None
 ) -> None:
-    """Records a job's success and completes its task (now, or once func constraints allow).
-
-    `accepted_at`: when the cobot accepted the step (the driver's on_sent); the lease's
-    start when not given. `ring`: the doorbell of the job's queue rings after the commit (a
-    worker that leases the cobot's next job itself says no)."""
+    """Records a job's success and completes its task (now, or once func constraints allow);
+    the doorbell of the job's queue rings after the commit. `accepted_at`: when the cobot
+    accepted the step (the driver's on_sent); the lease's start when not given."""
     with transaction.atomic():
-        case, job = _locked_job(lease)
-        if job is None:
-            return
-        job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
-        job.accepted_at = accepted_at or job.started_at
-        # Written with the case: what the task's completion reads of jobs is other jobs'.
-        case.keep(job, ["state", "result", "ended_at", "accepted_at"])
-        if job.work_item.state == WorkItemState.CANCELLED:
-            events.record_event(
-                case, EventType.CANCELLED_STEP_ENDED, item=job.work_item, detail={"result": result}
-            )
-        elif case.status in OPEN_CASE_STATUSES:
-            progress.complete_cobot_task(case, net_of(case), job.work_item, result)
-        case.save()
-        if ring:
+        job = _finish(lease, result, accepted_at)
+        if job is not None:
             _ring_for_next_on_commit(job)
+
+
+def _finish_and_lease_next(
+    lease: Lease, result: dict[str, Any], *, accepted_at: dt.datetime | None, hand_over: bool
+) -> Lease | None:
+    """finish_job without the doorbell, and the cobot's next job leased (as _lease_next) in the
+    same transaction: one commit where there were two. It holds the finished case's lock, so
+    it waits for no other: where the cobot's row or the next job's case is locked, the next job
+    is leased after the commit, as a doorbell leases it."""
+    with transaction.atomic():
+        _finish(lease, result, accepted_at)
+        try:
+            return _take_next("id = %s", lease.cobot.pk, hand_over=hand_over, wait=False)
+        except _LockTaken:
+            pass
+    return _lease_next("id = %s", lease.cobot.pk, hand_over=hand_over)
+
+
+def _finish(lease: Lease, result: dict[str, Any], accepted_at: dt.datetime | None) -> Job | None:
+    """finish_job's writes, in the caller's transaction: the job; None when this worker's lease
+    is no longer the job's (nothing written)."""
+    case, job = _locked_job(lease)
+    if job is None:
+        return None
+    job.state, job.result, job.ended_at = JobState.SUCCEEDED, result, timezone.now()
+    job.accepted_at = accepted_at or job.started_at
+    # Written with the case: what the task's completion reads of jobs is other jobs'.
+    case.keep(job, ["state", "result", "ended_at", "accepted_at"])
+    if job.work_item.state == WorkItemState.CANCELLED:
+        events.record_event(
+            case, EventType.CANCELLED_STEP_ENDED, item=job.work_item, detail={"result": result}
+        )
+    elif case.status in OPEN_CASE_STATUSES:
+        progress.complete_cobot_task(case, net_of(case), job.work_item, result)
+    case.save()
+    return job
 
 
 def _ring_for_next_on_commit(job: Job) -> None:

@@ -435,11 +435,16 @@ def complete_task(
 def start_cobot_task(case: Case, net: CaseNet, item: WorkItem) -> None:
     """Starts a cobot task as its cobot takes the job (jobs.lease_next_job).
 
-    Call while holding the case row lock, with the start enabled; the caller saves the case.
+    Call while holding the case row lock, with the start enabled; the caller saves the case,
+    and with it the item when its start changes nothing else (advance_after_start): then
+    nothing reads the item before that save.
     """
     start_task(case, net, item, None)
+    if item.task in net.starts_alone:
+        case.keep(item, ["state", "started_at"])
+        return
     rows.update(item, ["state", "started_at"])
-    advance_after_start(case, net, item.task)
+    advance(case, net)
 
 
 def advance_after_start(case: Case, net: CaseNet, task: str) -> None:

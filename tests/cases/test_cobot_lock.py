@@ -10,6 +10,7 @@ one on the same cobot (two use-case cases sharing cobots did exactly that).
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import threading
 from collections.abc import Callable
@@ -98,17 +99,25 @@ def _waiting_for_a_lock() -> bool:
         return bool(cursor.fetchone()[0])
 
 
-def _reach_while_held(hold: Callable[[], Any], reach: Callable[[], Any], waited: str) -> tuple[Any, Any]:  # fmt: skip
+def _reach_while_held(
+    hold: Callable[[], Any],
+    reach: Callable[[], Any],
+    waited: str,
+    *,
+    reach_commits: bool = False,
+    meanwhile: Callable[[], None] = lambda: None,
+) -> tuple[Any, Any]:
     """Runs `hold` in a transaction held open on a thread of its own, then `reach` in one on
-    another thread, which must come to wait for a lock (`waited`: the failure if it never
-    does); then lets `hold` commit. Returns what each returned."""
+    another thread (`reach_commits`: in none, as it commits its own), which must come to wait
+    for a lock (`waited`: the failure if it never does); runs `meanwhile`, then lets `hold`
+    commit. Returns what each returned."""
     held = threading.Event()
     release = threading.Event()
     results: dict[str, Any] = {}
 
-    def run(name: str, call: Callable[[], Any], then: Callable[[], None]) -> None:
+    def run(name: str, call: Callable[[], Any], then: Callable[[], None], atomic: bool) -> None:
         try:
-            with transaction.atomic():
+            with transaction.atomic() if atomic else contextlib.nullcontext():
                 results[name] = call()
                 then()
         finally:
@@ -118,15 +127,18 @@ def _reach_while_held(hold: Callable[[], Any], reach: Callable[[], Any], waited:
         held.set()
         release.wait(30)
 
-    holder = threading.Thread(target=run, args=("hold", hold, hold_open))
+    holder = threading.Thread(target=run, args=("hold", hold, hold_open, True))
     holder.start()
     assert held.wait(30)
-    reacher = threading.Thread(target=run, args=("reach", reach, lambda: None))
+    reacher = threading.Thread(target=run, args=("reach", reach, lambda: None, not reach_commits))
     reacher.start()
     until(_waiting_for_a_lock, 30, 0.01, waited)
-    release.set()
-    holder.join(30)
-    reacher.join(30)
+    try:
+        meanwhile()
+    finally:
+        release.set()
+        holder.join(30)
+        reacher.join(30)
     return results["hold"], results["reach"]
 
 
@@ -147,6 +159,43 @@ def test_a_lease_that_waited_for_the_cobot_sees_the_job_leased_meanwhile(
     assert first is not None
     assert second is None  # the cobot is busy with the first job
     assert Job.objects.filter(cobot=cobot, state=JobState.RUNNING).count() == 1
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.parametrize("locked", ["the cobot's row", "the next job's case"])
+def test_a_finish_that_finds_a_lock_taken_commits_then_leases_the_next_job_once_it_is_free(
+    broker: RedisProcess, organisation: Organisation, engineer: User, operator: User, locked: str
+) -> None:
+    # A worker done with a step leases the cobot's next job in the finish's transaction
+    # (jobs._finish_and_lease_next), holding the finished case's lock: it must wait for no
+    # other lock there, or two sessions could each wait for the other.
+    cobot = _two_jobs_queued_on_one_cobot(organisation, engineer, operator)
+    first = jobs.lease_next_job(cobot.pk)
+    assert first is not None
+    second = Job.objects.get(cobot=cobot, state=JobState.QUEUED)
+
+    def hold() -> None:
+        if locked == "the cobot's row":
+            Cobot.objects.select_for_update(no_key=True).get(pk=cobot.pk)
+        else:
+            progress.lock_case(second.case_id)
+
+    def finished_meanwhile() -> None:
+        assert Job.objects.get(pk=first.job_id).state == JobState.SUCCEEDED
+        assert Job.objects.get(pk=second.pk).state == JobState.QUEUED
+
+    _, taken = _reach_while_held(
+        hold,
+        lambda: jobs._finish_and_lease_next(
+            first, {"outcome": "ran", "seconds": 0}, accepted_at=None, hand_over=False
+        ),
+        "the lease after the finish never waited",
+        reach_commits=True,
+        meanwhile=finished_meanwhile,
+    )
+    assert taken is not None
+    assert taken.job_id == second.pk
+    assert Job.objects.get(pk=second.pk).state == JobState.RUNNING
 
 
 @pytest.mark.django_db(transaction=True)

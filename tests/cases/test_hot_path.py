@@ -13,6 +13,7 @@ from typing import Any
 import pytest
 from django.contrib.auth.models import User
 from django.db import connection, connections, transaction
+from django.test.utils import CaptureQueriesContext
 from django.utils import timezone
 
 from hrc.cases import dispatch, jobs, progress, services
@@ -103,9 +104,9 @@ def test_a_completion_leases_the_step_for_a_free_cobot_and_sends_the_lease_not_a
     assert (message["job"], message["lease"], message["cobot"]["name"]) == (job.pk, 1, cobot.name)
     assert message["command"] == job.command
     # The case and the item locked, its completion, the open items, the step's offer with its
-    # job, the cobot's row, the step's start (which starts alone: no second read of the open
-    # items), then the log, the lease and the case in one statement.
-    assert len(statements.sent) == 7, statements.sent
+    # job, the cobot's row, then the log, the step's start (which starts alone: no second read
+    # of the open items), the lease and the case in one statement.
+    assert len(statements.sent) == 6, statements.sent
 
 
 def test_a_step_whose_command_cannot_be_made_is_offered_with_its_job_failed_and_an_incident(
@@ -238,7 +239,7 @@ def test_the_finish_runs_a_fixed_number_of_statements(
     # The case, the job and its item locked in one statement, the item's completion, the open
     # items, then the log, the job and the case in one statement; after the commit, whether
     # the cobot has a job queued (a worker that leases the next job itself asks nothing:
-    # ring=False).
+    # jobs._finish_and_lease_next).
     assert len(statements.sent) == 5, statements.sent
 
 
@@ -251,10 +252,41 @@ def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
         lease = jobs._lease_next("id = %s", cobot.pk)  # what a doorbell runs (run_next_job)
     assert lease is not None
     assert lease.job_id == _job(item).pk
-    # The cobot's lock, its queue, the case, the job and its item locked in one statement, the
-    # step's start (alone: nothing else to offer or withdraw), then the log, the lease and the
+    # The cobot's lock, its queue, the case, the job and its item locked in one statement, then
+    # the log, the step's start (alone: nothing else to offer or withdraw), the lease and the
     # case in one statement.
-    assert len(statements.sent) == 5, statements.sent
+    assert len(statements.sent) == 4, statements.sent
+
+
+def test_a_worker_done_with_a_step_leases_the_next_in_the_same_transaction(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    first = factories.hand_over_started(
+        version, started_by=engineer, operator=operator, cobot=cobot
+    )
+    second = factories.hand_over_started(
+        version, started_by=engineer, operator=operator, cobot=cobot
+    )
+    lease = _leased(first, operator)
+    with sent_tasks():
+        services.complete_work_item(second, user=operator)  # queued behind the first
+    assert jobs._claim(lease)
+    with sent_tasks() as rung, CaptureQueriesContext(connection) as captured:
+        taken = jobs._finish_and_lease_next(
+            lease, {"outcome": "ran", "seconds": 0.0}, accepted_at=None, hand_over=False
+        )
+    job = _job(second)
+    assert taken is not None
+    assert taken.job_id == job.pk
+    assert (job.state, job.held_by) == (JobState.RUNNING, progress.worker_name())
+    assert Case.objects.get(pk=first.case_id).status == CaseStatus.COMPLETED
+    assert rung == []  # no doorbell, no message: this worker drives the next job
+    sent = [query["sql"] for query in captured.captured_queries]
+    control = [sql for sql in sent if sql.startswith(("BEGIN", "COMMIT", "SAVEPOINT"))]
+    # finish_job's statements but the doorbell's question after the commit (4), then a
+    # doorbell's lease (4), under one commit.
+    assert control == ["BEGIN", "COMMIT"], control
+    assert len(sent) - len(control) == 8, sent
 
 
 def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_hand_it_over(
@@ -271,8 +303,9 @@ def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_
         services.complete_work_item(second, user=operator)  # queued behind the first
     assert jobs._claim(lease)
     with sent_tasks() as rung:
-        jobs.finish_job(lease, {"outcome": "ran", "seconds": 0.0}, ring=False)
-        handed = jobs._lease_next("id = %s", cobot.pk, hand_over=True)
+        handed = jobs._finish_and_lease_next(
+            lease, {"outcome": "ran", "seconds": 0.0}, accepted_at=None, hand_over=True
+        )
     job = _job(second)
     assert handed is not None
     assert handed.job_id == job.pk
