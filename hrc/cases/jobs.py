@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import math
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -611,6 +612,21 @@ def _locked_job(lease: Lease) -> tuple[Case, Job | None]:
 
 
 # The sweeper ------------------------------------------------------------------------
+
+# When this process last swept (time.monotonic()), for sweep_is_due.
+_last_sweep = {"at": -math.inf}
+
+
+def sweep_is_due() -> bool:
+    """Whether this process sweeps now: not when it swept less than half a period ago (and then
+    it counts as sweeping now). Beat sends a sweep every HRC_SWEEP_SECONDS whether the last one
+    ran or not: those that piled up in the broker while the workers were busy or away would
+    run back to back, each a whole sweep, just as the workers catch up."""
+    now = time.monotonic()
+    if now - _last_sweep["at"] < settings.HRC_SWEEP_SECONDS / 2:
+        return False
+    _last_sweep["at"] = now
+    return True
 
 
 def sweep() -> dict[str, int]:
