@@ -258,9 +258,11 @@ def test_a_doorbells_lease_runs_a_fixed_number_of_statements(
     assert len(statements.sent) == 4, statements.sent
 
 
-def test_a_worker_done_with_a_step_leases_the_next_in_the_same_transaction(
+def _claimed_with_one_behind(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
-) -> None:
+) -> tuple[WorkItem, jobs.Lease, WorkItem]:
+    """Two operator tasks completed for one cobot: the first's step leased and claimed by this
+    worker, the second's queued behind it. (first item, its lease, second item)"""
     first = factories.hand_over_started(
         version, started_by=engineer, operator=operator, cobot=cobot
     )
@@ -271,6 +273,13 @@ def test_a_worker_done_with_a_step_leases_the_next_in_the_same_transaction(
     with sent_tasks():
         services.complete_work_item(second, user=operator)  # queued behind the first
     assert jobs._claim(lease)
+    return first, lease, second
+
+
+def test_a_worker_done_with_a_step_leases_the_next_in_the_same_transaction(
+    version: PatternVersion, engineer: User, operator: User, cobot: Cobot
+) -> None:
+    first, lease, second = _claimed_with_one_behind(version, engineer, operator, cobot)
     with sent_tasks() as rung, CaptureQueriesContext(connection) as captured:
         taken = jobs._finish_and_lease_next(
             lease, {"outcome": "ran", "seconds": 0.0}, accepted_at=None, hand_over=False
@@ -292,16 +301,7 @@ def test_a_worker_done_with_a_step_leases_the_next_in_the_same_transaction(
 def test_a_worker_done_with_a_step_leases_the_next_for_the_workers_when_told_to_hand_it_over(
     version: PatternVersion, engineer: User, operator: User, cobot: Cobot
 ) -> None:
-    first = factories.hand_over_started(
-        version, started_by=engineer, operator=operator, cobot=cobot
-    )
-    second = factories.hand_over_started(
-        version, started_by=engineer, operator=operator, cobot=cobot
-    )
-    lease = _leased(first, operator)
-    with sent_tasks():
-        services.complete_work_item(second, user=operator)  # queued behind the first
-    assert jobs._claim(lease)
+    _, lease, second = _claimed_with_one_behind(version, engineer, operator, cobot)
     with sent_tasks() as rung:
         handed = jobs._finish_and_lease_next(
             lease, {"outcome": "ran", "seconds": 0.0}, accepted_at=None, hand_over=True
