@@ -158,27 +158,27 @@ def _run(lease: Lease, hand_over: Callable[[], bool]) -> Lease | None:
         accepted.append(timezone.now())
         hold.release()
 
-    result: dict[str, Any] | None = None
+    result: dict[str, Any] = {}
+    failure: DriverError | None = None
     try:
         result = _execute(lease, on_sent=on_sent)
     except DriverError as error:
-        fail_job(lease, error, accepted_at=accepted[0] if accepted else None)
+        failure = error
     except Exception as error:
         # A fault of ours, not the cobot's answer: the step's outcome is unknown, so it is
         # never sent again by itself (a person retries, with the step's token).
         logger.exception("Job %s failed unexpectedly", lease.job_id)
-        message = (
+        failure = DriverError(
             f"hrc failed while running the step ({error!r}); it is not sent again by itself. "
             "See the workers' log, check the cobot, then retry or skip."
         )
-        fail_job(lease, DriverError(message), accepted_at=accepted[0] if accepted else None)
     finally:
         hold.release()
-    handing = hand_over()
-    if result is None:
+    accepted_at, handing = (accepted[0] if accepted else None), hand_over()
+    if failure is not None:
+        fail_job(lease, failure, accepted_at=accepted_at)
         taken = _lease_next("id = %s", lease.cobot.pk, hand_over=handing)
     else:
-        accepted_at = accepted[0] if accepted else None
         taken = _finish_and_lease_next(lease, result, accepted_at=accepted_at, hand_over=handing)
     return None if handing else taken
 
