@@ -19,8 +19,7 @@ served over HTTP on 127.0.0.1 by daphne, as in production. In one run:
     warm-up batch through the same workers (max(10, 4 x cobots x workers)
     cases, so every worker has in all likelihood driven every cobot and
     opened its sessions: a row measures the steady state, not connection
-    set-up), and with the database's statistics up to date (ANALYZE once the
-    cases are prepared, as autovacuum keeps them in a plant). Target: with 2 workers, >= 0.5 of the CPU-bound ceiling measured
+    set-up). Target: with 2 workers, >= 0.5 of the CPU-bound ceiling measured
     in the same run. Also the SQL statements one case costs (see
     measure_statements), by who runs them.
 (c) one operator step (start and complete through the services) in cases
@@ -466,8 +465,7 @@ def _throughput_row(bench: Rig, cases: int, workers: int) -> dict[str, Any]:
     cobot job queued, its doorbell waiting in the broker); then all workers take the queue.
 
     An untimed warm-up batch goes the same way first, so that the timed cases
-    find every worker's connections and driver sessions open; the database is
-    analysed once the timed cases are prepared (Rig.analyze).
+    find every worker's connections and driver sessions open.
     """
     from django.db.models import Max, Min
 
@@ -484,7 +482,6 @@ def _throughput_row(bench: Rig, cases: int, workers: int) -> dict[str, Any]:
     started = time.perf_counter()
     ids = _queue_cases(bench, cases)
     prepared = time.perf_counter() - started
-    bench.analyze()
     sessions = _sessions_opened()
     meter = CpuMeter(lambda: _row_cpu(bench)).start()
     released = time.time()

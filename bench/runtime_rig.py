@@ -554,16 +554,6 @@ class Rig:
             worker = WorkerProcess(self.workdir, name=name, environment=environment, beat=first)
             self.workers.append(worker.start())
 
-    def analyze(self) -> None:
-        """Gives PostgreSQL the statistics of what the run wrote, as autovacuum keeps them in a
-        running plant (and pgbench after loading its tables): to the planner, a scratch table
-        filled within the last minute is still empty, and its plans for an empty table walk a
-        cobot's whole history of work items on every lease."""
-        from django.db import connection
-
-        with connection.cursor() as cursor:
-            cursor.execute("ANALYZE")
-
     def worker_nodes(self) -> list[str]:
         return [f"{worker.name}@{socket.gethostname()}" for worker in self.workers]
 
