@@ -34,15 +34,7 @@ from typing import Any, cast
 
 from django.conf import settings
 from django.db import transaction
-from django.db.models import (
-    BooleanField,
-    Exists,
-    ExpressionWrapper,
-    OuterRef,
-    Q,
-    QuerySet,
-    Subquery,
-)
+from django.db.models import Exists, OuterRef, QuerySet, Subquery
 from django.utils import timezone
 
 from hrc.cases import dispatch, events, interruptions, progress, rows
@@ -264,21 +256,13 @@ def _queue(cobot: int, now: dt.datetime) -> QuerySet[Job, Any]:
     pause for an operator in a shared area, a person's command (power, program) under way).
     `held`: another case's func hold reserves the cobot; the holding case's own jobs may go
     (its pattern may give the cobot the supported task itself). `speed_due`: a slowdown or its
-    end waits to be sent (the worker sends it before the step).
-
-    `held` asks first, once, whether any item holds the cobot at all, and only then, row by
-    row, whether it is another case's: PostgreSQL skips the per-row question when the first
-    answer is no, as it almost always is. Planned on stale statistics (a table filled since
-    the last ANALYZE), that question read every work item the cobot ever had, for each row."""
-    holding = holding_work_items().filter(cobot_id=cobot)
+    end waits to be sent (the worker sends it before the step)."""
     return Job.objects.filter(
         cobot=cobot, state=JobState.QUEUED, next_try_at__lte=now, case__status=CaseStatus.RUNNING,
     ).annotate(
         busy=Exists(Job.objects.filter(cobot=cobot, state=JobState.RUNNING)),
         paused=Exists(progress.unsettled_pauses(cobot)),
-        held=ExpressionWrapper(
-            Q(Exists(holding)) & Q(Exists(_held_by_another_case(cobot))), BooleanField()
-        ),
+        held=Exists(_held_by_another_case(cobot)),
         commanded=Exists(running_commands(now).filter(cobot=cobot)),
         speed_due=Exists(progress.speed_changes_due(cobot)),
     ).values_list("pk", "case_id", "busy", "paused", "held", "commanded", "speed_due")[
