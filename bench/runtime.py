@@ -20,7 +20,8 @@ served over HTTP on 127.0.0.1 by daphne, as in production. In one run:
     cases, so every worker has in all likelihood driven every cobot and
     opened its sessions: a row measures the steady state, not connection
     set-up). Target: with 2 workers, >= 0.5 of the CPU-bound ceiling measured
-    in the same run. Also the SQL statements one case costs (see
+    in the same run (from the floors measured before and after the rows:
+    their mean). Also the SQL statements one case costs (see
     measure_statements), by who runs them.
 (c) one operator step (start and complete through the services) in cases
     whose logs hold ~10 and ~1000 events: the cost must not grow (long /
@@ -326,29 +327,33 @@ def _wait_completed(first: int, last: int, timeout: float = 60.0, poll: float = 
 
 # (b) throughput -------------------------------------------------------------------------------
 
+# How often (b) asks whether a row's cases have all completed.
+WAIT_POLL_SECONDS = 0.25
 STATEMENT_CASES = 5  # cases whose statements are counted; the counts hardly vary
 COMPLETION_PHASE = "completion"  # services.complete_work_item, in the completing request
 
 
 def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str], None]) -> dict[str, Any]:  # fmt: skip
-    bench.use_workers(0)
     progress(f"throughput floors: {settings.cases} bare Celery tasks, steps, ORM transactions ...")  # fmt: skip
-    (tasks_per_second, task_cpu), (steps_per_second, step_cpu) = (
-        _celery_rate(bench, settings.cases), _step_rate(bench, settings.cases)
-    )  # fmt: skip
-    _, record_cpu = _orm_floor(bench, 0, settings.cases)
-    floors = {"celery_tasks_per_second": tasks_per_second, "steps_per_second": steps_per_second}
+    before = _throughput_floors(bench, settings.cases, again=0)
     progress(f"statements per case: {STATEMENT_CASES} cases run inline in this process ...")
     statements = measure_statements(bench, STATEMENT_CASES)
     rows = []
     for count in settings.workers:
         progress(f"throughput: {settings.cases} cases, {len(bench.cobots)} cobots, {count} worker(s) ...")  # fmt: skip
         rows.append(_throughput_row(bench, settings.cases, count))
+    progress("throughput floors again, after the rows ...")
+    after = _throughput_floors(bench, settings.cases, again=1)
+
+    def mean(part: str) -> dict[str, float]:
+        return {name: round((before[part][name] + after[part][name]) / 2, 3) for name in before[part]}  # fmt: skip
+
+    floors, floor_cpu_ms = mean("rates"), mean("cpu_ms")
     for row in rows:
         row["ratio_to_floors"] = {
             name: round(row["cases_per_second"] / rate, 3) for name, rate in floors.items()
         }
-    cores, floor_cpu = os.cpu_count() or 1, task_cpu + step_cpu + record_cpu
+    cores, floor_cpu = os.cpu_count() or 1, sum(floor_cpu_ms.values())
     bound = round(cores * 1000 / floor_cpu, 1) if floor_cpu else None  # None: no /proc
     return {
         "pattern": SIGNAL_SHAPE,
@@ -356,13 +361,33 @@ def measure_throughput(bench: Rig, settings: Settings, progress: Callable[[str],
         "floors": floors,
         # Every case needs at least one Celery task, one step, and one transaction to record
         # it: the CPU those cost, spread over all of this machine's cores with nothing else
-        # to do, bounds any design on this stack.
-        "floor_cpu_ms": {"celery_task": task_cpu, "step": step_cpu, "orm_transaction": record_cpu},
+        # to do, bounds any design on this stack. Measured before and after the rows, and
+        # their mean taken: this machine's speed drifts by half within minutes, and a ceiling
+        # measured on one side only carried that drift into the share.
+        "floor_cpu_ms": floor_cpu_ms,
+        "floor_cpu_ms_before_and_after": [before["cpu_ms"], after["cpu_ms"]],
         "floor_cpu_bound_cases_per_second": bound,
         "cores": cores,
         "rows": rows,
         "statements_per_case": statements,
         **throughput_verdict(rows, bound),
+    }
+
+
+def _throughput_floors(bench: Rig, count: int, again: int) -> dict[str, dict[str, float]]:
+    """The rates of the bare parts of a case (count of each, nothing else running) and the CPU
+    ms each costs: {"rates": ..., "cpu_ms": ...}. `again` as in _step_rate."""
+    bench.use_workers(0)
+    (tasks_per_second, task_cpu), (steps_per_second, step_cpu) = (
+        _celery_rate(bench, count), _step_rate(bench, count, again)
+    )  # fmt: skip
+    _, record_cpu = _orm_floor(bench, 0, count)
+    return {
+        "rates": {
+            "celery_tasks_per_second": tasks_per_second,
+            "steps_per_second": steps_per_second,
+        },
+        "cpu_ms": {"celery_task": task_cpu, "step": step_cpu, "orm_transaction": record_cpu},
     }
 
 
@@ -422,9 +447,10 @@ def _celery_rate(bench: Rig, count: int) -> tuple[float, float]:
     return round((count - 1) / (starts[-1] - starts[0]), 1), _ms_each(cpu, "celery", count)
 
 
-def _step_rate(bench: Rig, count: int) -> tuple[float, float]:
+def _step_rate(bench: Rig, count: int, again: int) -> tuple[float, float]:
     """Zero-time steps per second through one driver to one simulated cobot, one after another,
-    and the CPU ms per step of this process (the driver) and the gateway.
+    and the CPU ms per step of this process (the driver) and the gateway. `again`: how many
+    times this run measured it before (each time's fences are new to the cobot).
 
     Each case of (b) runs one such step; the driver is hrc's (the four-phase
     handshake with its fencing token), called from this process, nothing else around it.
@@ -436,7 +462,8 @@ def _step_rate(bench: Rig, count: int) -> tuple[float, float]:
     driver = driver_for(cobot.name, gateway.endpoint, step_timeout=30.0)
     roles = [os.getpid(), *([gateway.process.pid] if gateway.process else [])]
     try:
-        steps = [StepCommand(step=STEP, fence=Fence(FLOOR_VALUES_FROM + n)) for n in range(count)]
+        first = FLOOR_VALUES_FROM + count * again  # a fence the cobot has not seen
+        steps = [StepCommand(step=STEP, fence=Fence(first + n)) for n in range(count)]
         driver.run_step(steps[0])  # the session and its subscription
         meter = _processes_meter("step", roles)
         started = time.perf_counter()
@@ -486,7 +513,9 @@ def _throughput_row(bench: Rig, cases: int, workers: int) -> dict[str, Any]:
     meter = CpuMeter(lambda: _row_cpu(bench)).start()
     released = time.time()
     _control(app.control.add_consumer, queue, bench.worker_nodes())
-    _wait_completed(ids[0], ids[-1], timeout=600.0, poll=0.05)
+    # Seldom: this process's queries would take CPU from what it measures, and the row's time
+    # comes from the cases' ended_at, not from when a poll saw them.
+    _wait_completed(ids[0], ids[-1], timeout=600.0, poll=WAIT_POLL_SECONDS)
     cpu = meter.stop()
     time.sleep(1.0)  # PostgreSQL publishes its statistics at most once a second
     sessions = _sessions_opened() - sessions
@@ -822,9 +851,13 @@ def print_table(report: Mapping[str, Any]) -> None:
           f"   ours / floor: {', '.join(str(r['ratio_to_floors']['steps_per_second']) for r in throughput['rows'])}")  # fmt: skip
     cpu, bound = throughput["floor_cpu_ms"], throughput["floor_cpu_bound_cases_per_second"]
     if bound is not None:
+        sides = " and ".join(
+            f"{sum(side.values()):.2f}" for side in throughput["floor_cpu_ms_before_and_after"]
+        )
         print(f"floor CPU per case: a bare task {cpu['celery_task']:.2f} ms (worker, Redis) + a bare step "
               f"{cpu['step']:.2f} ms (driver, gateway) + an ORM transaction {cpu['orm_transaction']:.2f} ms "
-              f"(Django, PostgreSQL)\n  = at most {bound} cases/s on {throughput['cores']} cores, whatever the design")  # fmt: skip
+              f"(Django, PostgreSQL); the mean of {sides} ms, before and after the rows\n"
+              f"  = at most {bound} cases/s on {throughput['cores']} cores, whatever the design")  # fmt: skip
     print_statements(throughput["statements_per_case"])
     target = throughput["target"]
     print(f"target with {target['workers']} workers >= {target['share_of_cpu_bound']:g} × the CPU bound "

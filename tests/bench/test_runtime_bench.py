@@ -185,6 +185,12 @@ def test_a_quick_run_writes_the_report_and_leaves_nothing_behind(tmp_path: Path)
     cpu = throughput["floor_cpu_ms"]
     assert set(cpu) == {"celery_task", "step", "orm_transaction"}
     assert all(ms > 0 for ms in cpu.values())
+    # The ceiling's floors are measured on both sides of the rows; their mean is the one used.
+    before, after = throughput["floor_cpu_ms_before_and_after"]
+    for name, ms in cpu.items():
+        assert before[name] > 0
+        assert after[name] > 0
+        assert ms == pytest.approx((before[name] + after[name]) / 2, abs=0.001)
     bound = throughput["cores"] * 1000 / sum(cpu.values())
     assert throughput["floor_cpu_bound_cases_per_second"] == pytest.approx(bound, abs=0.1)
     assert isinstance(throughput["meets_target"], bool)
